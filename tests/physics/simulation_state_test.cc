@@ -171,3 +171,110 @@ TEST(SimulationState, ApplyMocapDriversPosesOnlyTheListedDrivenBodies) {
 
 }  // namespace
 }  // namespace penumbra
+
+namespace penumbra {
+namespace {
+
+// MuJoCo 4's state beyond qpos ... userdata: a motor that acts with a 20 ms delay (a history
+// buffer of 10 samples: docs XMLreference actuator nsample / delay), a hinge whose spring
+// yields (springyield: its reference moves, mjData.plastic), a ball welded to the world (an
+// equality constraint, switched through eq_active)
+constexpr char kMujoco4StateXml[] = R"(<mujoco><option timestep="0.002"/><worldbody>
+  <geom name="floor" type="plane" size="3 3 0.1"/>
+  <body name="arm" pos="0 0 1"><joint name="hinge" axis="0 1 0" stiffness="5" springyield="5"/>
+    <geom type="capsule" fromto="0 0 0 0.4 0 0" size="0.03" mass="0.5"/></body>
+  <body name="ball" pos="1 0 0.5"><freejoint/><geom type="sphere" size="0.1"/></body>
+  </worldbody>
+  <equality><weld name="hold" body1="ball"/></equality>
+  <actuator><motor name="m" joint="hinge" nsample="10" delay="0.02"/></actuator></mujoco>)";
+
+// the motor's command at step k: a pure function of the step, so a restart can repeat it
+double CommandAt(int64_t k) { return 4.0 * std::sin(0.05 * static_cast<double>(k)); }
+
+// `steps` steps, each with the command of the step it starts from
+Trace StepWithCommands(Simulation* sim, int steps) {
+  Trace t;
+  for (int i = 0; i < steps; ++i) {
+    sim->ctrl()[0] = CommandAt(sim->step_count());
+    sim->Step();
+    t.qpos.emplace_back(sim->qpos().begin(), sim->qpos().end());
+    t.qvel.emplace_back(sim->qvel().begin(), sim->qvel().end());
+  }
+  return t;
+}
+
+bool SameTrace(const Trace& a, const Trace& b) { return a.qpos == b.qpos && a.qvel == b.qvel; }
+
+// the run every test restarts: 150 steps of commands, the weld switched off at step 100
+// (through SetState, as a restored state would), 100 more; the state then and what followed
+struct Mujoco4Run {
+  SimState saved;
+  Trace rest;
+};
+Mujoco4Run RunMujoco4Model() {
+  Simulation sim = Simulation::LoadFromString(kMujoco4StateXml);
+  StepWithCommands(&sim, 100);
+  SimState off = sim.GetState();
+  EXPECT_EQ(off.eq_active, std::vector<double>{1});
+  off.eq_active = {0};
+  sim.SetState(off);
+  EXPECT_EQ(sim.GetState().eq_active, std::vector<double>{0});
+  StepWithCommands(&sim, 150);
+  Mujoco4Run run;
+  run.saved = sim.GetState();
+  run.rest = StepWithCommands(&sim, 200);
+  return run;
+}
+
+TEST(SimulationState, HistoryEqActiveAndPlasticStateRestartBitExactly) {
+  const Mujoco4Run run = RunMujoco4Model();
+  const SimState& saved = run.saved;
+  // the state holds them: 10 samples of the delayed motor (with their times), the weld off, the
+  // hinge spring's moved reference
+  Simulation fresh = Simulation::LoadFromString(kMujoco4StateXml);
+  const SimState initial = fresh.GetState();
+  EXPECT_GE(saved.history.size(), 10u);
+  EXPECT_NE(saved.history, initial.history);
+  EXPECT_EQ(saved.eq_active, std::vector<double>{0});
+  EXPECT_EQ(initial.eq_active, std::vector<double>{1});
+  ASSERT_EQ(saved.plastic.size(), 1u);
+  EXPECT_NE(saved.plastic, initial.plastic);  // the spring yielded
+  EXPECT_TRUE(saved.plugin_state.empty());
+
+  // a fresh simulation of the model set to that state continues bit for bit
+  fresh.SetState(saved);
+  ExpectIdentical(run.rest, StepWithCommands(&fresh, 200));
+
+  // and each of the three is needed: restored without it, the run goes elsewhere
+  const auto without = [&](std::vector<double> SimState::*field) {
+    Simulation other = Simulation::LoadFromString(kMujoco4StateXml);
+    SimState s = saved;
+    s.*field = initial.*field;
+    other.SetState(s);
+    return StepWithCommands(&other, 200);
+  };
+  EXPECT_FALSE(SameTrace(run.rest, without(&SimState::history))) << "history";
+  EXPECT_FALSE(SameTrace(run.rest, without(&SimState::eq_active))) << "eq_active";
+  EXPECT_FALSE(SameTrace(run.rest, without(&SimState::plastic))) << "plastic";
+}
+
+TEST(SimulationState, AnEqActiveOtherThanZeroOrOneIsRefusedAndChangesNothing) {
+  Simulation sim = Simulation::LoadFromString(kMujoco4StateXml);
+  StepWithCommands(&sim, 10);
+  const SimState before = sim.GetState();
+  SimState s = before;
+  s.eq_active = {0.5};
+  s.qpos[0] = 1;
+  try {
+    sim.SetState(s);
+    FAIL() << "expected an Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("eq_active[0] is 0.5; expected 0 or 1"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(sim.GetState().qpos, before.qpos);
+  EXPECT_EQ(sim.GetState().eq_active, before.eq_active);
+}
+
+}  // namespace
+}  // namespace penumbra

@@ -52,6 +52,10 @@ StepRecord RecordOf(const RunLogLayout& l, int64_t step) {
   fill(&r.mocap_pos, 3 * l.nmocap, 800);
   fill(&r.mocap_quat, 4 * l.nmocap, 900);
   fill(&r.userdata, l.nuserdata, 1000);
+  fill(&r.history, l.nhistory, 1100);
+  r.eq_active.assign(l.neq, 0);
+  fill(&r.plugin_state, l.npluginstate, 1200);
+  fill(&r.plastic, l.nplastic, 1300);
   return r;
 }
 
@@ -67,6 +71,10 @@ SimState EmptyState(const RunLogLayout& l) {
   s.mocap_pos.assign(3 * l.nmocap, -1);
   s.mocap_quat.assign(4 * l.nmocap, -1);
   s.userdata.assign(l.nuserdata, -1);
+  s.history.assign(l.nhistory, -1);
+  s.eq_active.assign(l.neq, 1);
+  s.plugin_state.assign(l.npluginstate, -1);
+  s.plastic.assign(l.nplastic, -1);
   return s;
 }
 
@@ -200,6 +208,61 @@ TEST(StateMap, ARecordOfAnotherSizeIsRefused) {
   r.qvel.pop_back();
   SimState s = EmptyState(l);
   EXPECT_THROW(map.Apply(r, &s), Error);
+}
+
+// MuJoCo 4's history buffers, equality switches, plugin and plastic state: per model, copied
+// whole
+RunLogLayout WithMujoco4State(RunLogLayout l) {
+  l.nhistory = 4;
+  l.neq = 2;
+  l.npluginstate = 1;
+  l.nplastic = 3;
+  return l;
+}
+
+TEST(StateMap, HistoryEqualitiesPluginAndPlasticStateAreCopiedWhole) {
+  const RunLogLayout l = WithMujoco4State(RecordedLayout());
+  const StateMap map(l, l, "run.plog");
+  EXPECT_TRUE(map.identity());
+  const StepRecord r = RecordOf(l, 9);
+  SimState s = EmptyState(l);
+  map.Apply(r, &s);
+  EXPECT_EQ(s.history, (std::vector<double>{1100, 1101, 1102, 1103}));
+  EXPECT_EQ(s.eq_active, (std::vector<double>{0, 0}));
+  EXPECT_EQ(s.plugin_state, std::vector<double>{1200});
+  EXPECT_EQ(s.plastic, (std::vector<double>{1300, 1301, 1302}));
+  // the rest as before
+  EXPECT_EQ(s.qpos, r.qpos);
+}
+
+// a format 1 log (MuJoCo 2.2.2) records none of them: the replay model keeps its own, and the
+// layouts still count as the same (a resimulation compares only what the log holds)
+TEST(StateMap, ALogWithoutThemKeepsTheReplayModelsOwn) {
+  const RunLogLayout log = RecordedLayout();
+  const RunLogLayout m = WithMujoco4State(log);
+  const StateMap map(log, m, "run.plog");
+  EXPECT_TRUE(map.identity());
+  SimState s = EmptyState(m);
+  map.Apply(RecordOf(log, 3), &s);
+  EXPECT_EQ(s.history, std::vector<double>(4, -1));
+  EXPECT_EQ(s.eq_active, std::vector<double>(2, 1));
+  EXPECT_EQ(s.plugin_state, std::vector<double>(1, -1));
+  EXPECT_EQ(s.plastic, std::vector<double>(3, -1));
+  EXPECT_EQ(s.qvel, RecordOf(log, 3).qvel);
+}
+
+TEST(StateMap, AnotherCountOfThemThanTheLogsIsRefusedNamingIt) {
+  const RunLogLayout log = WithMujoco4State(RecordedLayout());
+  RunLogLayout m = log;
+  m.neq = 3;
+  EXPECT_NE(ErrorOf(log, m).find("the replay model's neq is 3; the log records 2"),
+            std::string::npos)
+      << ErrorOf(log, m);
+  m = log;
+  m.nhistory = 0;
+  EXPECT_NE(ErrorOf(log, m).find("the replay model's nhistory is 0; the log records 4"),
+            std::string::npos)
+      << ErrorOf(log, m);
 }
 
 }  // namespace

@@ -222,7 +222,7 @@ TEST(RunLogBoundsTest, RecordCountsAndZeroFieldsBeyondTheBodyOrLayoutAreRefused)
   bounds_codec::PutF64(&zero, 0.0);
   bounds_codec::PutU8(&zero, bounds_codec::kFieldZero);
   bounds_codec::PutU32(&zero, UINT32_MAX);
-  for (int f = 1; f < 11; ++f) {
+  for (int f = 1; f < kNumStateFields; ++f) {
     bounds_codec::PutU8(&zero, bounds_codec::kFieldZero);
     bounds_codec::PutU32(&zero, 0);
   }

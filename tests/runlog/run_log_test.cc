@@ -41,6 +41,10 @@ RunLogHeader TestHeader() {
   l.nuserdata = 2;
   l.nbody = 3;
   l.num_controllers = 1;
+  l.nhistory = 5;
+  l.neq = 2;
+  l.npluginstate = 1;
+  l.nplastic = 3;
   l.joints = {{"ball", "free", 0, 7, 0, 6}, {"arm", "hinge", 7, 1, 6, 1}};
   l.actuator_names = {"a0", "a1"};
   l.mocap_body_names = {"agents/bob"};
@@ -70,6 +74,10 @@ StepRecord TestStep(int64_t step) {
   r.mocap_quat = {1, 0, 0, 0};
   r.userdata = {std::numeric_limits<double>::quiet_NaN(), static_cast<double>(step)};
   r.controller_next_update = {step / 10 * 10 + 10};
+  for (int i = 0; i < 5; ++i) r.history.push_back(std::sin(t - 0.002 * i));
+  r.eq_active = {1, step < 50 ? 1.0 : 0.0};
+  r.plugin_state = {-t};
+  r.plastic = {0, t * t, -0.0};
   return r;
 }
 
@@ -96,6 +104,10 @@ void ExpectSameStep(const StepRecord& a, const StepRecord& b) {
   EXPECT_TRUE(SameBits(a.mocap_quat, b.mocap_quat)) << a.step;
   EXPECT_TRUE(SameBits(a.userdata, b.userdata)) << a.step;
   EXPECT_EQ(a.controller_next_update, b.controller_next_update) << a.step;
+  EXPECT_TRUE(SameBits(a.history, b.history)) << a.step;
+  EXPECT_TRUE(SameBits(a.eq_active, b.eq_active)) << a.step;
+  EXPECT_TRUE(SameBits(a.plugin_state, b.plugin_state)) << a.step;
+  EXPECT_TRUE(SameBits(a.plastic, b.plastic)) << a.step;
 }
 
 // a closed log of steps 0..n-1 in chunks of `chunk_steps`, with an event every 7 steps
@@ -184,6 +196,7 @@ TEST(RunLogTest, RoundTripOfEveryRecordKind) {
   EXPECT_EQ(h.timestep_sec, 0.002);
   EXPECT_EQ(h.layout.nq, 8);
   EXPECT_EQ(h.layout.nbody, 3);
+  EXPECT_EQ(h.layout.dims(), e.layout.dims());  // nhistory, neq, npluginstate, nplastic too
   ASSERT_EQ(h.layout.joints.size(), 2u);
   EXPECT_EQ(h.layout.joints[1].name, "arm");
   EXPECT_EQ(h.layout.joints[1].qvel_adr, 6);
@@ -289,12 +302,12 @@ TEST(RunLogTest, AnotherFormatVersionIsRefusedNamingTheVersionsThatReadIt) {
   testing::TempDir tmp;
   const std::string path = WriteLog(tmp, 10, 4);
   std::string bytes = ReadBytes(path);
-  bytes[8] = 2;  // the u32 format version after the 8-byte magic
+  bytes[8] = 3;  // the u32 format version after the 8-byte magic
   WriteBytes(path, bytes);
   const std::string err = OpenError(path, RunLogReadMode::kRecover);
-  EXPECT_NE(err.find("run log format version 2 (written by penumbra 9.8.7)"), std::string::npos)
+  EXPECT_NE(err.find("run log format version 3 (written by penumbra 9.8.7)"), std::string::npos)
       << err;
-  EXPECT_NE(err.find("reads run log format version 1"), std::string::npos) << err;
+  EXPECT_NE(err.find("reads run log format version 1, 2"), std::string::npos) << err;
 }
 
 TEST(RunLogTest, ATruncatedHeaderIsAClearErrorInBothModes) {

@@ -23,6 +23,10 @@ StateDims SomeDims() {
   d[StateDim::kNuserdata] = 4;
   d[StateDim::kNbody] = 5;
   d[StateDim::kNumControllers] = 2;
+  d[StateDim::kNhistory] = 6;
+  d[StateDim::kNeq] = 3;
+  d[StateDim::kNpluginstate] = 0;
+  d[StateDim::kNplastic] = 2;
   return d;
 }
 
@@ -53,10 +57,24 @@ TEST(SimStateTable, OneRowPerMemberWithItsNameAndSize) {
   EXPECT_EQ(&(s.*StateFieldOf(StateField::kMocapQuat).f64), &s.mocap_quat);
   EXPECT_EQ(&(s.*StateFieldOf(StateField::kControllerNextUpdate).i64), &s.controller_next_update);
   EXPECT_FALSE(StateFieldOf(StateField::kControllerNextUpdate).mujoco);
+  // MuJoCo 4's integration state beyond 2.2.2's: history buffers, equality switches (the one
+  // flag field), plugin and plastic state
+  EXPECT_EQ(&(s.*StateFieldOf(StateField::kHistory).f64), &s.history);
+  EXPECT_EQ(&(s.*StateFieldOf(StateField::kEqActive).f64), &s.eq_active);
+  EXPECT_EQ(&(s.*StateFieldOf(StateField::kPluginState).f64), &s.plugin_state);
+  EXPECT_EQ(&(s.*StateFieldOf(StateField::kPlastic).f64), &s.plastic);
+  for (const StateFieldInfo& f : kStateFields)
+    EXPECT_EQ(f.flag, f.field == StateField::kEqActive) << f.name;
+  EXPECT_EQ(StateFieldOf(StateField::kEqActive).name, "eq_active");
+  EXPECT_EQ(kStateDimNames[static_cast<size_t>(StateDim::kNhistory)], "nhistory");
+  EXPECT_EQ(kStateDimNames[static_cast<size_t>(StateDim::kNplastic)], "nplastic");
   const StateDims d = SomeDims();
   EXPECT_EQ(StateFieldSize(StateFieldOf(StateField::kXfrcApplied), d), 30);
   EXPECT_EQ(StateFieldSize(StateFieldOf(StateField::kMocapQuat), d), 8);
   EXPECT_EQ(StateFieldSize(StateFieldOf(StateField::kQaccWarmstart), d), 7);
+  EXPECT_EQ(StateFieldSize(StateFieldOf(StateField::kHistory), d), 6);
+  EXPECT_EQ(StateFieldSize(StateFieldOf(StateField::kEqActive), d), 3);
+  EXPECT_EQ(StateFieldSize(StateFieldOf(StateField::kPlastic), d), 2);
 }
 
 TEST(SimStateTable, DimsAndSizeChecks) {
@@ -64,12 +82,19 @@ TEST(SimStateTable, DimsAndSizeChecks) {
   SimState s;
   FillState(&s, dims, 1);
   EXPECT_EQ(StateDimsOf(s), dims);
-  EXPECT_EQ(StateSizeMismatch(s, dims), "");
+  s.eq_active = {1, 0, 1};
+  EXPECT_EQ(StateMismatch(s, dims), "");
+  // a flag is 0 or 1 (MuJoCo's mjtBool): anything else is named with its index
+  s.eq_active[1] = 0.5;
+  EXPECT_EQ(StateMismatch(s, dims), "eq_active[1] is 0.5; expected 0 or 1");
+  s.eq_active[1] = 0;
+  s.history.pop_back();
+  EXPECT_EQ(StateMismatch(s, dims), "history has 5 entries; expected 6");
   s.mocap_quat.pop_back();
-  EXPECT_EQ(StateSizeMismatch(s, dims), "mocap_quat has 7 entries; expected 8");
+  EXPECT_EQ(StateMismatch(s, dims), "mocap_quat has 7 entries; expected 8");
   s.qvel.push_back(0);
   // the first field in table order is named
-  EXPECT_EQ(StateSizeMismatch(s, dims), "qvel has 8 entries; expected 7");
+  EXPECT_EQ(StateMismatch(s, dims), "qvel has 8 entries; expected 7");
 }
 
 TEST(SimStateTable, ASnapshotIsASimStateAndCopiesExactlyTheState) {

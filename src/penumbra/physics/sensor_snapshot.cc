@@ -1,7 +1,5 @@
 #include "penumbra/physics/sensor_snapshot.h"
 
-#include <cstring>
-
 #include "penumbra/physics/mujoco_state.h"
 
 namespace penumbra {
@@ -10,9 +8,7 @@ void CopyStateForForward(const mjModel* m, const mjData* live, mjData* d) {
   d->time = live->time;
   const StateDims dims = MujocoStateDims(m, 0);
   for (const StateFieldInfo& f : kStateFields)
-    if (f.mujoco)
-      std::memcpy(MujocoStatePtr(d, f.field), MujocoStatePtr(live, f.field),
-                  sizeof(mjtNum) * StateFieldSize(f, dims));
+    if (f.mujoco) CopyMujocoState(live, d, f.field, StateFieldSize(f, dims));
 }
 
 void FillSensorGroundTruth(const mjModel* m, const mjData* d, WorldSnapshot* out) {

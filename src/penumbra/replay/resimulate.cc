@@ -70,8 +70,13 @@ std::string EntryOwner(const RunLogLayout& l, StateField field, int64_t i) {
                                             : named(l.mocap_body_names, i, "mocap body", 4, kWxyz);
     case StateDim::kNumControllers:
       return named(l.controller_names, i, "controller", 1, nullptr);
+    case StateDim::kNeq:
+      return fmt::format("equality constraint {}", i);
     case StateDim::kNa:
     case StateDim::kNuserdata:
+    case StateDim::kNhistory:
+    case StateDim::kNpluginstate:
+    case StateDim::kNplastic:
       return "";
   }
   return "";
@@ -80,9 +85,12 @@ std::string EntryOwner(const RunLogLayout& l, StateField field, int64_t i) {
 bool SameEntry(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
 bool SameEntry(int64_t a, int64_t b) { return a == b; }
 
-// the first difference between the logged record and the simulated state, if any
+// the first difference between the logged record and the simulated state, if any, in the
+// fields a log of `format_version` holds (RunLogStateShapeOf: a format 1 log has no history,
+// eq_active, plugin_state or plastic)
 std::optional<Divergence> Compare(const StepRecord& r, const SimState& s, const RunLogLayout& l,
-                                  bool check_schedule) {
+                                  bool check_schedule, uint32_t format_version) {
+  const int recorded_fields = RunLogStateShapeOf(format_version).fields;
   Divergence d;
   d.step = r.step;
   d.time_sec = r.time_sec;
@@ -101,7 +109,9 @@ std::optional<Divergence> Compare(const StepRecord& r, const SimState& s, const 
   bool found = false;
   ForEachStateField(
       [&](const StateFieldInfo& f, const auto& a, const auto& b) {
-        if (found || (f.field == StateField::kControllerNextUpdate && !check_schedule)) return;
+        if (found || static_cast<int>(f.field) >= recorded_fields ||
+            (f.field == StateField::kControllerNextUpdate && !check_schedule))
+          return;
         if (a.size() != b.size()) {
           d.field = "size of " + std::string(f.name);
           d.logged = static_cast<double>(a.size());
@@ -134,6 +144,7 @@ class LogCheck : public Sink {
            StepRecord first, ResimulateReport* report)
       : reader_(reader),
         layout_(layout),
+        format_version_(reader->header().format_version),
         controllers_(controllers),
         log_path_(std::move(log_path)),
         record_(std::move(first)),
@@ -161,7 +172,7 @@ class LogCheck : public Sink {
   void OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot) override {
     if (snapshot->step <= last_checked_) return;
     last_checked_ = snapshot->step;
-    report_->divergence = Compare(record_, *snapshot, layout_, controllers_);
+    report_->divergence = Compare(record_, *snapshot, layout_, controllers_, format_version_);
     ++report_->steps_checked;
     report_->last_step = record_.step;
   }
@@ -169,6 +180,7 @@ class LogCheck : public Sink {
  private:
   RunLogReader* reader_;
   const RunLogLayout& layout_;
+  uint32_t format_version_;
   bool controllers_;
   std::string log_path_;
   StepRecord record_;  // of the step the simulation takes next, or has just taken

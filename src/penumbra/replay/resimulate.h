@@ -23,9 +23,11 @@
 // quantity (metrics/metrics_sink.h MetricsMode::kDynamics) and run.json (its "replay" object
 // has mode "resimulate" and the verdict). without an output folder nothing is written.
 //
-// MuJoCo 2.2.2 computes a step from exactly the state the log holds (physics/simulation.h
-// SimState), so a run is bit-exact as long as the model, the world and the binary's floating
-// point are those of the recording (changed model files are warned about).
+// MuJoCo computes a step from exactly the state the log holds (scene/sim_state.h SimState),
+// so a run is bit-exact as long as the model, the world, the MuJoCo version and the binary's
+// floating point are those of the recording (changed model files are warned about). a format 1
+// log (MuJoCo 2.2.2) holds no history, eq_active, plugin_state or plastic: those are not
+// compared.
 
 #include <atomic>
 #include <cstdint>

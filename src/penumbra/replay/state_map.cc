@@ -24,10 +24,18 @@ bool SameJoints(const std::vector<RunLogJoint>& a, const std::vector<RunLogJoint
   return true;
 }
 
-// the same sizes (but the controllers', which are not mapped) and names
+// the dimensions copied whole when log and model agree, kept as the model's when the log holds
+// none (a format 1 log records none of them)
+constexpr StateDim kWholeIfRecorded[] = {StateDim::kNhistory, StateDim::kNeq,
+                                         StateDim::kNpluginstate, StateDim::kNplastic};
+
+// the same sizes (but the controllers', which are not mapped, and those of kWholeIfRecorded the
+// log does not hold) and names
 bool SameLayout(const RunLogLayout& a, const RunLogLayout& b) {
   StateDims da = a.dims(), db = b.dims();
   da[StateDim::kNumControllers] = db[StateDim::kNumControllers] = 0;
+  for (const StateDim dim : kWholeIfRecorded)
+    if (da[dim] == 0) db[dim] = 0;
   return da == db && SameJoints(a.joints, b.joints) && a.actuator_names == b.actuator_names &&
          a.mocap_body_names == b.mocap_body_names && a.body_names == b.body_names;
 }
@@ -141,6 +149,17 @@ StateMap::StateMap(const RunLogLayout& log, const RunLogLayout& model, const std
     fail("the replay model has " + std::to_string(model.nuserdata) +
          " userdata entries; the log records " + std::to_string(log.nuserdata) + kFixed);
   AddSpan(&Spans(StateDim::kNuserdata), 0, 0, log.nuserdata);
+
+  // history buffers, equality switches, plugin and plastic state: whole, where logged
+  const StateDims log_dims = log.dims(), model_dims = model.dims();
+  for (const StateDim dim : kWholeIfRecorded) {
+    if (log_dims[dim] == 0) continue;
+    const std::string_view name = kStateDimNames[static_cast<size_t>(dim)];
+    if (log_dims[dim] != model_dims[dim])
+      fail("the replay model's " + std::string(name) + " is " + std::to_string(model_dims[dim]) +
+           "; the log records " + std::to_string(log_dims[dim]) + kFixed);
+    AddSpan(&Spans(dim), 0, 0, static_cast<int>(log_dims[dim]));
+  }
 
   // mocap bodies: logged ones follow the log, the model's others keep their drivers
   const std::vector<int> mocap_to = MatchNames(log.mocap_body_names, model.mocap_body_names);

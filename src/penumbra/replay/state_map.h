@@ -20,6 +20,10 @@
 //                  time: an adversity preset's NPCs added by the replay).
 //   bodies         xfrc_applied is copied per body name; bodies of one side only keep zero.
 //   userdata       copied whole; a different nuserdata is an error.
+//   history, eq_active, plugin_state, plastic
+//                  copied whole; a different nhistory, neq, npluginstate or nplastic is an
+//                  error, but for a log that holds none (a format 1 log records none of them,
+//                  docs/run-log.md "Versions"): the replay model keeps its own values.
 // unnamed objects (MJCF without a name) are matched by their order among the unnamed objects of
 // the same kind. the controllers' schedule (controller_next_update) is not mapped: a kinematic
 // replay runs no controllers.
@@ -41,7 +45,8 @@ class StateMap {
   /// live/run_log_header.h RunLogLayoutOf). `log_name` names the log in errors.
   /// @throws ConfigError(log_name, 0, "", ...) naming the first joint or actuator of the log
   ///         that the replay model lacks or holds with another type or width, the first joint
-  ///         or actuator of the replay model that the log lacks, or a different nuserdata.
+  ///         or actuator of the replay model that the log lacks, a different nuserdata, or
+  ///         a different nhistory, neq, npluginstate or nplastic where the log holds some.
   StateMap(const RunLogLayout& log, const RunLogLayout& model, const std::string& log_name);
 
   /// writes the values of `record` (sizes of the log's layout) into `state` (sizes of the
@@ -55,7 +60,8 @@ class StateMap {
   const std::vector<int>& unlogged_mocap() const { return unlogged_mocap_; }
   /// names of the logged mocap bodies the replay model lacks (dropped), in log order.
   const std::vector<std::string>& dropped_mocap() const { return dropped_mocap_; }
-  /// true when both layouts are the same (every vector is copied whole, index for index).
+  /// true when both layouts are the same (every vector the log holds is copied whole, index
+  /// for index).
   bool identity() const { return identity_; }
 
  private:

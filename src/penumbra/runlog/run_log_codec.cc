@@ -217,8 +217,8 @@ void EncodeStep(const StepRecord& r, const StepRecord* prev, std::string* body) 
   }
 }
 
-void DecodeStep(BodyReader* in, const StepRecord* prev, StepRecord* out,
-                const RunLogLayout* layout) {
+void DecodeStep(BodyReader* in, const StepRecord* prev, StepRecord* out, const RunLogLayout* layout,
+                uint32_t format_version) {
   out->step = in->I64();
   out->time_sec = in->F64();
   // entries each field must have (-1: no layout given)
@@ -226,15 +226,28 @@ void DecodeStep(BodyReader* in, const StepRecord* prev, StepRecord* out,
   const auto want = [&](const StateFieldInfo& f) -> int64_t {
     return layout ? StateFieldSize(f, dims) : -1;
   };
+  // the fields of the log's version are in the record; later ones are not
+  const int fields = RunLogStateShapeOf(format_version).fields;
+  const auto recorded = [fields](const StateFieldInfo& f) {
+    return static_cast<int>(f.field) < fields;
+  };
   if (prev) {
-    ForEachStateField([&](const StateFieldInfo& f, auto& v,
-                          const auto& pv) { DecodeField(in, &pv, f.name, want(f), &v); },
-                      *out, *prev);
+    ForEachStateField(
+        [&](const StateFieldInfo& f, auto& v, const auto& pv) {
+          if (recorded(f))
+            DecodeField(in, &pv, f.name, want(f), &v);
+          else
+            v.clear();
+        },
+        *out, *prev);
   } else {
     ForEachStateField(
         [&](const StateFieldInfo& f, auto& v) {
-          DecodeField(in, static_cast<const std::decay_t<decltype(v)>*>(nullptr), f.name, want(f),
-                      &v);
+          if (recorded(f))
+            DecodeField(in, static_cast<const std::decay_t<decltype(v)>*>(nullptr), f.name, want(f),
+                        &v);
+          else
+            v.clear();
         },
         *out);
   }
@@ -330,7 +343,8 @@ std::string HeaderToJson(const RunLogHeader& h) {
                  {"body_names", l.body_names},
                  {"controller_names", l.controller_names}};
   const StateDims dims = l.dims();
-  for (int i = 0; i < kNumStateDims; ++i) layout[std::string(kStateDimNames[i])] = dims.n[i];
+  for (int i = 0; i < RunLogStateShapeOf(h.format_version).dims; ++i)
+    layout[std::string(kStateDimNames[i])] = dims.n[i];
   json j = {{"format_version", h.format_version},
             {"penumbra_version", h.penumbra_version},
             {"mujoco_version", h.mujoco_version},
@@ -413,8 +427,10 @@ RunLogHeader HeaderFromJson(std::string_view text) {
   }
   RunLogLayout& l = h.layout;
   const char* w = "layout: ";
+  // the dimensions of the log's format version (a format 1 layout has no nhistory, neq,
+  // npluginstate or nplastic: they count 0)
   StateDims dims;
-  for (int i = 0; i < kNumStateDims; ++i) {
+  for (int i = 0; i < RunLogStateShapeOf(h.format_version).dims; ++i) {
     int n = 0;
     get(layout, std::string(kStateDimNames[i]).c_str(), &n, w);
     dims.n[i] = n;

@@ -53,8 +53,11 @@ inline constexpr int kMaxLayoutEntries = 1 << 22;
 /// most memory the decoded records of one chunk may take (512 MiB): a steps chunk's record
 /// count times StepRecordMemoryBytes(layout). the writer closes steps chunks at half of it.
 inline constexpr uint64_t kMaxChunkDecodedBytes = uint64_t{512} << 20;
-/// bytes of the smallest record of each kind in a body (all strings and fields empty).
-inline constexpr uint64_t kMinStepRecordBytes = 16 + uint64_t{kNumStateFields} * 5;
+/// bytes of the smallest record of each kind in a body (all strings and fields empty); a
+/// step record's depend on the fields of the log's format version (RunLogStateShapeOf).
+constexpr uint64_t MinStepRecordBytes(uint32_t format_version) {
+  return 16 + uint64_t(RunLogStateShapeOf(format_version).fields) * 5;
+}
 inline constexpr uint64_t kMinEventRecordBytes = 16 + 4 + 8;
 inline constexpr uint64_t kMinSensorRecordBytes = 16 + 4 + 4 + 8;
 
@@ -155,11 +158,14 @@ class BodyReader {
 /// appends `r` to a steps body; `prev` is the previous record of the same chunk (null for
 /// the chunk's first), against which fields of equal size are XORed.
 void EncodeStep(const StepRecord& r, const StepRecord* prev, std::string* body);
-/// reads one step record; `prev` as for EncodeStep. with a `layout`, every field must have the
-/// layout's number of entries (as the writer enforces); without one, at most kMaxLayoutEntries.
+/// reads one step record of a log of `format_version`, whose fields are the first ones of
+/// kStateFields (RunLogStateShapeOf; the others are left empty); `prev` as for EncodeStep.
+/// with a `layout`, every field must have the layout's number of entries (as the writer
+/// enforces); without one, at most kMaxLayoutEntries.
 /// @throws RunLogError on malformed data (naming the field, the entries found and expected).
 void DecodeStep(BodyReader* in, const StepRecord* prev, StepRecord* out,
-                const RunLogLayout* layout = nullptr);
+                const RunLogLayout* layout = nullptr,
+                uint32_t format_version = kRunLogFormatVersion);
 
 /// appends an event / sensor record to a body.
 void EncodeEvent(const EventRecord& e, std::string* body);
@@ -168,10 +174,12 @@ void EncodeSensor(const SensorRecord& s, std::string* body);
 EventRecord DecodeEvent(BodyReader* in);
 SensorRecord DecodeSensor(BodyReader* in);
 
-/// the header as the JSON text of a header chunk.
+/// the header as the JSON text of a header chunk; its layout names the dimensions of
+/// h.format_version (RunLogStateShapeOf).
 std::string HeaderToJson(const RunLogHeader& h);
 /// parses a header chunk's JSON (at most kMaxHeaderJsonValues values nested at most
-/// kMaxHeaderJsonDepth deep) and checks its layout (CheckLayout).
+/// kMaxHeaderJsonDepth deep) and checks its layout (CheckLayout). the layout must name the
+/// dimensions of its format_version; those after them count 0.
 /// @throws RunLogError naming a missing or mistyped key, a bad layout or a cap exceeded.
 RunLogHeader HeaderFromJson(std::string_view json);
 

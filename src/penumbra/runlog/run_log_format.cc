@@ -37,10 +37,12 @@ std::string Sha256With(Feed&& feed) {
 
 // the counts of RunLogLayout by StateDim (kStateDimNames order)
 constexpr std::array<int RunLogLayout::*, kNumStateDims> kLayoutCounts = {
-    &RunLogLayout::nq,     &RunLogLayout::nv,
-    &RunLogLayout::na,     &RunLogLayout::nu,
-    &RunLogLayout::nmocap, &RunLogLayout::nuserdata,
-    &RunLogLayout::nbody,  &RunLogLayout::num_controllers};
+    &RunLogLayout::nq,           &RunLogLayout::nv,
+    &RunLogLayout::na,           &RunLogLayout::nu,
+    &RunLogLayout::nmocap,       &RunLogLayout::nuserdata,
+    &RunLogLayout::nbody,        &RunLogLayout::num_controllers,
+    &RunLogLayout::nhistory,     &RunLogLayout::neq,
+    &RunLogLayout::npluginstate, &RunLogLayout::nplastic};
 
 }  // namespace
 

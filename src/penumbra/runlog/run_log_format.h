@@ -1,8 +1,8 @@
 #pragma once
 // the run log (.plog): a versioned, chunked binary record of one `penumbra run` (issue 18):
 // a header (versions, the world and composed model texts, asset hashes, seed, command line,
-// timestep and the state layout with names), then per physics step the state MuJoCo 2.2.2
-// needs to continue bit for bit, plus events (commands, effect changes, notes) and optional
+// timestep and the state layout with names), then per physics step the state MuJoCo needs to
+// continue bit for bit, plus events (commands, effect changes, notes) and optional
 // sensor outputs. the byte layout is specified in docs/run-log.md; this file holds the
 // in-memory types the writer (runlog/run_log_writer.h) takes and the reader
 // (runlog/run_log_reader.h) returns, and the format constants.
@@ -29,9 +29,38 @@ namespace penumbra {
 inline constexpr std::array<uint8_t, 8> kRunLogMagic = {0x89, 'P', 'L', 'O', 'G', '\r', '\n', 0x1a};
 
 /// the format version this build writes (u32 after the magic).
-inline constexpr uint32_t kRunLogFormatVersion = 1;
+inline constexpr uint32_t kRunLogFormatVersion = 2;
 /// the format versions this build reads.
-inline constexpr std::array<uint32_t, 1> kRunLogReadableVersions = {1};
+inline constexpr std::array<uint32_t, 2> kRunLogReadableVersions = {1, 2};
+
+/// what the state of a log of one format version holds: a step record is the first `fields`
+/// rows of kStateFields (scene/sim_state.h; rows are only ever appended) and the header's
+/// layout names the first `dims` StateDims; the dimensions after those count 0 and the fields
+/// after those are empty when read.
+struct RunLogStateShape {
+  int fields = kNumStateFields;
+  int dims = kNumStateDims;
+};
+/// the state shape of format `version`: 1 (MuJoCo 2.2.2's state: qpos ... userdata,
+/// controller_next_update) 11 fields of 8 dimensions; 2 (MuJoCo 4's: history, eq_active,
+/// plugin_state and plastic added) all of them.
+constexpr RunLogStateShape RunLogStateShapeOf(uint32_t version) {
+  constexpr RunLogStateShape kFormat1 = {static_cast<int>(StateField::kControllerNextUpdate) + 1,
+                                         static_cast<int>(StateDim::kNumControllers) + 1};
+  return version == 1 ? kFormat1 : RunLogStateShape{};
+}
+namespace run_log_format_detail {
+// a version's fields are sized by that version's dimensions only
+constexpr bool ShapeFieldsUseItsDims(uint32_t version) {
+  const RunLogStateShape shape = RunLogStateShapeOf(version);
+  for (int i = 0; i < shape.fields; ++i)
+    if (static_cast<int>(kStateFields[i].dim) >= shape.dims) return false;
+  return shape.fields <= kNumStateFields && shape.dims <= kNumStateDims;
+}
+}  // namespace run_log_format_detail
+static_assert(run_log_format_detail::ShapeFieldsUseItsDims(1) &&
+                  run_log_format_detail::ShapeFieldsUseItsDims(kRunLogFormatVersion),
+              "RunLogStateShapeOf: a version's fields must be sized by its dimensions");
 
 /// a run log could not be written or read: I/O failure, not a run log, another format version,
 /// truncation or damage. messages name the file and, for damage, the chunk index and step.
@@ -61,6 +90,10 @@ struct RunLogLayout {
   int nuserdata = 0;        ///< size of userdata
   int nbody = 0;            ///< bodies including the world (xfrc_applied has 6 nbody entries)
   int num_controllers = 0;  ///< size of controller_next_update
+  int nhistory = 0;         ///< size of history (0 in a format 1 log)
+  int neq = 0;              ///< equality constraints: size of eq_active (0 in a format 1 log)
+  int npluginstate = 0;     ///< size of plugin_state (0 in a format 1 log)
+  int nplastic = 0;         ///< size of plastic (0 in a format 1 log)
   std::vector<RunLogJoint> joints;            ///< (njnt) by MuJoCo joint id
   std::vector<std::string> actuator_names;    ///< (nu) by actuator id = index into ctrl
   std::vector<std::string> mocap_body_names;  ///< (nmocap) by mocap id
@@ -86,7 +119,7 @@ struct RunLogHeader {
   /// the format version of the file (kRunLogFormatVersion when writing; set by the writer).
   uint32_t format_version = kRunLogFormatVersion;
   std::string penumbra_version;  ///< of the writer, e.g. "0.1.0"
-  std::string mujoco_version;    ///< e.g. "2.2.2"
+  std::string mujoco_version;    ///< e.g. "4.0.0"
   /// the world file (absolute path) and its text; both "" for a bare model run
   /// (`penumbra run model.xml`), which then has model_file / model_text.
   std::string world_file;
@@ -110,7 +143,7 @@ struct RunLogHeader {
 
 /// the simulation state after `step` steps: a SimState (scene/sim_state.h), vectors in
 /// MuJoCo's order and units, sizes from RunLogLayout::dims() (n = 0 entries allowed for an
-/// empty model part).
+/// empty model part; the fields a format 1 log does not hold are empty).
 using StepRecord = SimState;
 
 /// something that happened at a step besides the state: a command a bridge received, an

@@ -124,11 +124,12 @@ struct RunLogReader::Impl {
 
   std::vector<StepRecord> DecodeSteps(size_t pos) {
     const std::string body = Body(pos);
-    CheckRecordCount(pos, body.size(), kMinStepRecordBytes, StepRecordMemoryBytes(header.layout));
+    CheckRecordCount(pos, body.size(), MinStepRecordBytes(header.format_version),
+                     StepRecordMemoryBytes(header.layout));
     BodyReader in(body, fmt::format("{}: {}", path, ChunkName(chunks[pos])));
     std::vector<StepRecord> out(chunks[pos].record_count);
     for (size_t i = 0; i < out.size(); ++i)
-      DecodeStep(&in, i ? &out[i - 1] : nullptr, &out[i], &header.layout);
+      DecodeStep(&in, i ? &out[i - 1] : nullptr, &out[i], &header.layout, header.format_version);
     if (!in.done()) in.Fail("bytes left after the last record");
     return out;
   }

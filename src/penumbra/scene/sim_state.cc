@@ -1,5 +1,7 @@
 #include "penumbra/scene/sim_state.h"
 
+#include "penumbra/core/number_text.h"
+
 namespace penumbra {
 
 StateDims StateDimsOf(const SimState& state) {
@@ -12,7 +14,7 @@ StateDims StateDimsOf(const SimState& state) {
   return dims;
 }
 
-std::string StateSizeMismatch(const SimState& state, const StateDims& dims) {
+std::string StateMismatch(const SimState& state, const StateDims& dims) {
   std::string problem;
   ForEachStateField(
       [&](const StateFieldInfo& f, const auto& v) {
@@ -20,6 +22,11 @@ std::string StateSizeMismatch(const SimState& state, const StateDims& dims) {
         if (problem.empty() && static_cast<int64_t>(v.size()) != want)
           problem = std::string(f.name) + " has " + std::to_string(v.size()) +
                     " entries; expected " + std::to_string(want);
+        if (!f.flag) return;
+        for (size_t i = 0; i < v.size() && problem.empty(); ++i)
+          if (v[i] != 0 && v[i] != 1)
+            problem = std::string(f.name) + "[" + std::to_string(i) + "] is " +
+                      FormatG(static_cast<double>(v[i])) + "; expected 0 or 1";
       },
       state);
   return problem;

@@ -1,16 +1,17 @@
 #pragma once
 // the simulation state, written out once: `SimState` (what a bit-exact restart needs), the
 // `StateField` enum of its vectors and `kStateFields`, the table every copy, comparison, size
-// check and serialisation loops over (MuJoCo's own pattern: mjxmacro.h in 2.2.2, the
-// mjtState / mj_stateSize / mj_stateElemPtr of MuJoCo 3). the physics module maps a field to
+// check and serialisation loops over (MuJoCo's own pattern: mjxmacro.h, mjtState /
+// mj_stateSize / mj_stateElemPtr). the physics module maps a field to
 // its mjData array with one switch (physics/mujoco_state.h); nothing else names the fields one
 // by one. a snapshot (scene/world_snapshot.h) is a SimState plus what is derived from it; the
 // run log's step record (runlog/run_log_format.h) is a SimState.
 //
 // to add a field: a member here, its enumerator, its row in kStateFields (the row's place is
-// its place in a run log's step record: append, and raise the log's format version), and its
-// case in physics/mujoco_state.cc; a field whose size is a new model dimension also needs its
-// StateDim, StateDims member and name.
+// its place in a run log's step record: append, raise the log's format version and give it
+// its row and dimension counts in runlog/run_log_format.h RunLogStateShapeOf), and its case in
+// physics/mujoco_state.cc; a field whose size is a new model dimension also needs its
+// StateDim (appended), its name in kStateDimNames and its case in MujocoStateDims.
 
 #include <array>
 #include <cstdint>
@@ -21,14 +22,15 @@
 namespace penumbra {
 
 /// everything a bit-exact restart of a Simulation needs (Simulation::GetState / SetState),
-/// for MuJoCo 2.2.2: mj_step is a function of exactly these mjData fields (the set MuJoCo 3
-/// later named mjSTATE_INTEGRATION, less eq_active and plugin_state, which 2.2.2's mjData does
-/// not have: its eq_active is a model field penumbra never changes) and of the model; every
-/// other mjData field is recomputed from them by the next step's mj_forward. qacc_warmstart is
-/// the constraint solver's starting point: without it the next contact solve starts elsewhere
-/// and the trajectory differs in the last bits. plus penumbra's own: the step count (time is
-/// SimTimeOfStep(step, timestep)) and each controller's next update (its schedule on the
-/// controllers' clock, Simulation::ResetControllers).
+/// for MuJoCo 4: mj_step is a function of exactly these mjData fields (MuJoCo's
+/// mjSTATE_INTEGRATION less time, which is the step count's: SimTimeOfStep) and of the model;
+/// every other mjData field is recomputed from them by the next step's mj_forward.
+/// qacc_warmstart is the constraint solver's starting point: without it the next contact solve
+/// starts elsewhere and the trajectory differs in the last bits; history holds the delayed
+/// actuators' and sensors' past samples, plastic the plastic deformation of joints, tendons
+/// and flexes. plus penumbra's own: the step count (time is SimTimeOfStep(step, timestep)) and
+/// each controller's next update (its schedule on the controllers' clock,
+/// Simulation::ResetControllers).
 ///
 /// NOT included: the controllers' own memory (waypoint index, gait phase, integrators, ...),
 /// which Simulation::ResetControllers returns to its start, and the controllers' episode start.
@@ -36,7 +38,8 @@ namespace penumbra {
 /// simulation whose controllers keep no state between updates, or that has none. mocap
 /// drivers (Simulation::AddMocapDriver) are pure functions of time and need nothing.
 /// vectors are MuJoCo's, in its order and units; their sizes are in kStateFields (from the
-/// model's StateDims: nq, nv, na, nu, nbody, nmocap, nuserdata, number of controllers).
+/// model's StateDims: nq, nv, na, nu, nbody, nmocap, nuserdata, number of controllers,
+/// nhistory, neq, npluginstate, nplastic).
 struct SimState {
   int64_t step = 0;                    ///< steps completed since loading (0 = initial state)
   double time_sec = 0;                 ///< sim time, s (SimTimeOfStep(step, timestep))
@@ -52,6 +55,12 @@ struct SimState {
   std::vector<double> userdata;        ///< (nuserdata) MuJoCo user data
   /// (number of controllers) step index of each controller's next update (Controller::rate_hz)
   std::vector<int64_t> controller_next_update;
+  /// (nhistory) the history buffers of actuators and sensors with nsample > 0 (delays)
+  std::vector<double> history;
+  /// (neq) which equality constraints are on: 1 or 0 (MuJoCo's mjtBool, as a double)
+  std::vector<double> eq_active;
+  std::vector<double> plugin_state;  ///< (npluginstate) the plugins' state
+  std::vector<double> plastic;       ///< (nplastic) plastic deformation (springyield, flexes)
 };
 
 /// the vectors of SimState, in kStateFields order.
@@ -67,9 +76,13 @@ enum class StateField : uint8_t {
   kMocapQuat,
   kUserdata,
   kControllerNextUpdate,
+  kHistory,
+  kEqActive,
+  kPluginState,
+  kPlastic,
 };
 /// the number of StateField values (rows of kStateFields).
-inline constexpr int kNumStateFields = 11;
+inline constexpr int kNumStateFields = 15;
 
 /// the model dimension a state vector's size is a multiple of.
 enum class StateDim : uint8_t {
@@ -81,12 +94,17 @@ enum class StateDim : uint8_t {
   kNuserdata,       ///< MuJoCo nuserdata
   kNbody,           ///< MuJoCo nbody: bodies including the world
   kNumControllers,  ///< controllers of the Simulation
+  kNhistory,        ///< MuJoCo nhistory: entries of the history buffers
+  kNeq,             ///< MuJoCo neq: equality constraints
+  kNpluginstate,    ///< MuJoCo npluginstate: entries of the plugins' state
+  kNplastic,        ///< MuJoCo nplastic: entries of the plastic state
 };
 /// the number of StateDim values.
-inline constexpr int kNumStateDims = 8;
+inline constexpr int kNumStateDims = 12;
 /// the names of the dimensions by StateDim, as the run log's header layout spells them.
 inline constexpr std::array<std::string_view, kNumStateDims> kStateDimNames = {
-    "nq", "nv", "na", "nu", "nmocap", "nuserdata", "nbody", "num_controllers"};
+    "nq",       "nv",  "na",           "nu",      "nmocap", "nuserdata", "nbody", "num_controllers",
+    "nhistory", "neq", "npluginstate", "nplastic"};
 
 /// the sizes of one model's state (counts >= 0), indexed by StateDim.
 struct StateDims {
@@ -110,6 +128,8 @@ struct StateFieldInfo {
   std::vector<int64_t> SimState::*i64 = nullptr;
   /// true for an mjData array (physics/mujoco_state.h maps it); false for penumbra's own.
   bool mujoco = true;
+  /// true for a flag field: every entry is 0 or 1 (an mjtBool array of MuJoCo, eq_active).
+  bool flag = false;
 };
 
 /// every vector of SimState, in StateField order, which is also the order of a run log's step
@@ -127,20 +147,27 @@ inline constexpr std::array<StateFieldInfo, kNumStateFields> kStateFields = {{
     {StateField::kUserdata, "userdata", StateDim::kNuserdata, 1, &SimState::userdata},
     {StateField::kControllerNextUpdate, "controller_next_update", StateDim::kNumControllers, 1,
      nullptr, &SimState::controller_next_update, false},
+    {StateField::kHistory, "history", StateDim::kNhistory, 1, &SimState::history},
+    {StateField::kEqActive, "eq_active", StateDim::kNeq, 1, &SimState::eq_active, nullptr, true,
+     true},
+    {StateField::kPluginState, "plugin_state", StateDim::kNpluginstate, 1, &SimState::plugin_state},
+    {StateField::kPlastic, "plastic", StateDim::kNplastic, 1, &SimState::plastic},
 }};
 
 namespace sim_state_detail {
 constexpr bool TableInOrder() {
   for (int i = 0; i < kNumStateFields; ++i) {
     const StateFieldInfo& f = kStateFields[i];
-    if (static_cast<int>(f.field) != i || (f.f64 == nullptr) == (f.i64 == nullptr) || f.per < 1)
+    if (static_cast<int>(f.field) != i || (f.f64 == nullptr) == (f.i64 == nullptr) || f.per < 1 ||
+        (f.flag && (f.f64 == nullptr || !f.mujoco)))
       return false;
   }
   return true;
 }
 }  // namespace sim_state_detail
 static_assert(sim_state_detail::TableInOrder(),
-              "kStateFields: row i must be StateField i with exactly one member pointer");
+              "kStateFields: row i must be StateField i with exactly one member pointer (a flag "
+              "field: a double one of MuJoCo's)");
 
 /// the row of `field`.
 constexpr const StateFieldInfo& StateFieldOf(StateField field) {
@@ -170,8 +197,9 @@ void ForEachStateField(F&& f, S&... states) {
 /// the sizes `state`'s vectors imply (each size / per; 0 for an empty vector).
 StateDims StateDimsOf(const SimState& state);
 
-/// "" when every vector of `state` has the size `dims` gives; else "<field> has N entries;
-/// expected M" for the first that does not.
-std::string StateSizeMismatch(const SimState& state, const StateDims& dims);
+/// "" when every vector of `state` has the size `dims` gives and every entry of a flag field
+/// is 0 or 1; else the first problem: "<field> has N entries; expected M" or "eq_active[2] is
+/// 0.5; expected 0 or 1".
+std::string StateMismatch(const SimState& state, const StateDims& dims);
 
 }  // namespace penumbra
