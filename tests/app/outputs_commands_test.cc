@@ -187,6 +187,42 @@ TEST(FallDetection, ARobotOnItsBackIsReportedFallenInRunJsonAndOnStderr) {
   EXPECT_TRUE(uq["fall_time_sec"].is_null());
   EXPECT_LT(uq["max_tilt_deg"].get<double>(), 30.0);
   EXPECT_EQ(u.err.find("fell at"), std::string::npos) << u.err;
+  // but without its controller nothing holds the legs' pose: it sinks 0.23 m in its first
+  // second, a stumble from its initial pose (as a Menagerie model started in a qpos0 that is
+  // no standing pose), not a fall
+  EXPECT_TRUE(uq["stumbled_at_start"].get<bool>());
+  EXPECT_GT(uq["start_drop_m"].get<double>(), 0.15);
+  EXPECT_NE(u.err.find("robot 'quadruped' stumbled from its initial pose"), std::string::npos)
+      << u.err;
+
+  // with its controller (the bundled world) it starts settled and trots: no stumble
+  const testing::ProcessResult w =
+      RunPenumbra({"run", kOcSource + "/worlds/quadruped.yaml", "--out",
+                   (dir.path() / "trot").string(), "--quiet", "--duration", "1.2"},
+                  dir.path());
+  ASSERT_EQ(w.exit_code, 0) << w.err;
+  const nlohmann::json jw = nlohmann::json::parse(ReadAll(dir.path() / "trot" / "run.json"));
+  const nlohmann::json& wq = jw["falls"]["robots"]["quadruped"];
+  EXPECT_FALSE(wq["stumbled_at_start"].get<bool>());
+  EXPECT_LT(wq["start_drop_m"].get<double>(), 0.02);
+  EXPECT_LT(wq["start_tilt_change_deg"].get<double>(), 5.0);
+  EXPECT_EQ(w.err.find("stumbled"), std::string::npos) << w.err;
+
+  // upright but 0.5 m above the floor: it drops from its initial pose
+  const std::string dropped = dir.Write("dropped.yaml", OcQuadrupedWorld("0, 0, 0", "0.5"));
+  const testing::ProcessResult d = RunPenumbra(
+      {"run", dropped, "--out", (dir.path() / "dropped").string(), "--quiet"}, dir.path());
+  ASSERT_EQ(d.exit_code, 0) << d.err;
+  const nlohmann::json jd = nlohmann::json::parse(ReadAll(dir.path() / "dropped" / "run.json"));
+  const nlohmann::json& dq = jd["falls"]["robots"]["quadruped"];
+  EXPECT_TRUE(dq["stumbled_at_start"].get<bool>());
+  EXPECT_GT(dq["start_drop_m"].get<double>(), 0.3);
+  EXPECT_NE(d.err.find("robot 'quadruped' stumbled from its initial pose in its first 1 s"),
+            std::string::npos)
+      << d.err;
+  EXPECT_NE(d.err.find("set the robot's initial_keyframe"), std::string::npos) << d.err;
+  // the fallen robot stumbled too
+  EXPECT_TRUE(q["stumbled_at_start"].get<bool>());
 }
 
 }  // namespace

@@ -4,8 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 namespace penumbra {
 namespace {
@@ -59,6 +61,25 @@ TEST(FallDetector, OnlyATiltHeldForTheMinimumDurationIsAFall) {
   EXPECT_FALSE(e.result().fell);
   EXPECT_TRUE(std::isnan(e.result().fall_time_sec));
   EXPECT_EQ(e.result().max_tilt_deg, 80.0);
+}
+
+TEST(StartCheck, ADropOrATiltInTheFirstSecondIsAStumbleAndATakeOffIsNot) {
+  const auto run = [](auto z_of_t, auto tilt_of_t) {
+    StartCheck c;
+    int fired = 0;
+    for (int k = 0; k <= 200; ++k)
+      fired += c.Update(0.01 * k, tilt_of_t(0.01 * k), z_of_t(0.01 * k));
+    return std::pair(fired, c.stumbled());
+  };
+  const auto flat = [](double) { return 0.0; };
+  EXPECT_EQ(run([](double t) { return 0.5 - 0.4 * std::min(t, 0.5); }, flat), std::pair(1, true));
+  EXPECT_EQ(run([](double t) { return 0.5 + 1.5 * t; }, flat), std::pair(0, false)) << "take-off";
+  EXPECT_EQ(run([](double) { return 0.3; }, [](double t) { return t < 0.8 ? 2.0 : 20.0; }),
+            std::pair(1, true));
+  // after the window nothing counts
+  EXPECT_EQ(run([](double t) { return t < 1.2 ? 0.3 : 0.0; }, flat), std::pair(0, false));
+  // a robot that starts tilted on a slope and stays so
+  EXPECT_EQ(run([](double) { return 0.3; }, [](double) { return 40.0; }), std::pair(0, false));
 }
 
 }  // namespace

@@ -45,6 +45,24 @@ bool FallDetector::Update(double time_sec, double tilt_deg) {
   return true;
 }
 
+bool StartCheck::Update(double time_sec, double tilt_deg, double base_z_m) {
+  if (done_) return false;
+  if (!started_) {
+    started_ = true;
+    t0_ = time_sec;
+    tilt0_ = tilt_deg;
+    z0_ = base_z_m;
+  }
+  if (time_sec - t0_ > rule_.window_sec) {
+    done_ = true;
+    stumbled_ = max_drop_m_ > rule_.drop_m || max_tilt_change_ > rule_.tilt_change_deg;
+    return stumbled_;
+  }
+  max_drop_m_ = std::max(max_drop_m_, z0_ - base_z_m);
+  max_tilt_change_ = std::max(max_tilt_change_, std::abs(tilt_deg - tilt0_));
+  return false;
+}
+
 std::vector<FallTarget> FallTargets(const WorldConfig& world, const Simulation& sim) {
   std::vector<FallTarget> out;
   const std::vector<JointInfo>& joints = sim.model_info().joints;
@@ -57,7 +75,7 @@ std::vector<FallTarget> FallTargets(const WorldConfig& world, const Simulation& 
           j.body >= static_cast<int>(bodies.size()))
         continue;
       if (bodies[j.body].name.rfind(prefix, 0) != 0) continue;
-      out.push_back({m.name, bodies[j.body].name, j.qpos_adr + 3});
+      out.push_back({m.name, bodies[j.body].name, j.qpos_adr + 3, !m.initial_keyframe.empty()});
       break;
     }
   }
@@ -67,6 +85,7 @@ std::vector<FallTarget> FallTargets(const WorldConfig& world, const Simulation& 
 FallSink::FallSink(std::vector<FallTarget> targets, FallRule rule)
     : targets_(std::move(targets)), rule_(rule) {
   for (const FallTarget& t : targets_) detectors_.emplace_back(t.robot, t.body, rule_);
+  starts_.resize(targets_.size());
 }
 
 SnapshotContent FallSink::Wants(int64_t step, double time_sec) { return SnapshotContent::kState; }
@@ -77,8 +96,23 @@ void FallSink::OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot) 
     const int a = targets_[i].quat_adr;
     if (a < 0 || static_cast<size_t>(a) + 4 > qpos.size()) continue;
     const Eigen::Quaterniond q(qpos[a], qpos[a + 1], qpos[a + 2], qpos[a + 3]);
+    const double tilt = BaseTiltDeg(q);
+    StartCheck& start = starts_[i];
+    if (start.Update(snapshot->time_sec, tilt, qpos[a - 1])) {
+      spdlog::warn(
+          "robot '{}' stumbled from its initial pose in its first {:g} s: its base {} dropped "
+          "{:.3f} m and tilted {:.1f} deg{}",
+          targets_[i].robot, StartRule{}.window_sec, targets_[i].body, start.max_drop_m(),
+          start.max_tilt_change_deg(),
+          targets_[i].has_initial_keyframe
+              ? " (from the world file's initial_keyframe: is it a standing pose its "
+                "actuators hold?)"
+              : " (it starts in its model's reference pose qpos0, often not a standing one: "
+                "set the robot's initial_keyframe to a standing <key> of its MJCF, or give it a "
+                "controller that holds it)");
+    }
     FallDetector& d = detectors_[i];
-    if (d.Update(snapshot->time_sec, BaseTiltDeg(q))) {
+    if (d.Update(snapshot->time_sec, tilt)) {
       const RobotFall& r = d.result();
       spdlog::warn(
           "robot '{}' fell at {:.3f} s: its base {} tilted more than {:g} deg from upright for "
@@ -110,6 +144,10 @@ std::string FallSink::SummaryJson() const {
     e["fall_time_sec"] = r.fell ? nlohmann::ordered_json(r.fall_time_sec) : nullptr;
     e["max_tilt_deg"] = r.max_tilt_deg;
     e["max_tilt_time_sec"] = r.max_tilt_time_sec;
+    const StartCheck& start = starts_[&d - detectors_.data()];
+    e["start_drop_m"] = start.max_drop_m();
+    e["start_tilt_change_deg"] = start.max_tilt_change_deg();
+    e["stumbled_at_start"] = start.stumbled();
     robots[r.robot] = e;
   }
   j["robots"] = robots;

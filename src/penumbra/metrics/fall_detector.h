@@ -73,11 +73,46 @@ class FallDetector {
   double above_since_ = std::numeric_limits<double>::quiet_NaN();  // NaN: not above now
 };
 
+/// what counts as stumbling from the initial pose: within the first `window_sec` of the run
+/// the base drops more than `drop_m` below its starting height or tilts more than
+/// `tilt_change_deg` away from its starting tilt. a robot standing on its controller or resting
+/// on its contacts moves less (the bundled robots: a trot's tilt stays under 3.4 deg, a
+/// settled start drops less than 1 cm); a model whose reference pose qpos0 is not a standing
+/// one (Menagerie's ANYmal C: straight legs in the air, no actuator holding them) collapses.
+struct StartRule {
+  double window_sec = 1.0;        ///< > 0, simulated seconds from the first state seen
+  double drop_m = 0.1;            ///< > 0, m (upward motion, e.g. a take-off, never counts)
+  double tilt_change_deg = 15.0;  ///< (0, 180)
+};
+
+/// watches one robot's base over StartRule::window_sec from its first sample. not thread-safe.
+class StartCheck {
+ public:
+  explicit StartCheck(StartRule rule = {}) : rule_(rule) {}
+
+  /// the base's tilt (deg) and height (world z, m) at simulated time `time_sec`
+  /// (non-decreasing). returns true once: at the first sample past the window when the base
+  /// stumbled within it.
+  bool Update(double time_sec, double tilt_deg, double base_z_m);
+
+  double max_drop_m() const { return max_drop_m_; }                ///< within the window, m
+  double max_tilt_change_deg() const { return max_tilt_change_; }  ///< within the window
+  bool stumbled() const { return stumbled_; }  ///< decided once the window has passed
+
+ private:
+  StartRule rule_;
+  bool started_ = false, done_ = false, stumbled_ = false;
+  double t0_ = 0, tilt0_ = 0, z0_ = 0, max_drop_m_ = 0, max_tilt_change_ = 0;
+};
+
 /// a robot to watch: its name, base body and the qpos index of its free joint's quaternion.
 struct FallTarget {
   std::string robot;
   std::string body;
-  int quat_adr = 0;  ///< qpos index of w (x, y, z follow)
+  int quat_adr = 0;  ///< qpos index of w (x, y, z follow); its position is the 3 before
+  /// the world file names an initial_keyframe for the robot (the stumble warning then does not
+  /// suggest one)
+  bool has_initial_keyframe = false;
 };
 
 /// the robots of `world` with a free joint (the first free joint whose body's name starts
@@ -86,7 +121,10 @@ std::vector<FallTarget> FallTargets(const WorldConfig& world, const Simulation& 
 
 /// watches the fall targets at every physics step (kState snapshots) and warns through
 /// spdlog once per robot when it falls: "robot 'NAME' fell at T s: its base BODY tilted
-/// more than 60 deg from upright for 0.5 s (max tilt X deg so far)".
+/// more than 60 deg from upright for 0.5 s (max tilt X deg so far)", and once when it
+/// stumbles from its initial pose (StartRule): "robot 'NAME' stumbled from its initial pose
+/// in its first 1 s: its base BODY dropped D m and tilted T deg ...", with a hint to start it
+/// from a standing keyframe.
 class FallSink : public Sink {
  public:
   explicit FallSink(std::vector<FallTarget> targets, FallRule rule = {});
@@ -103,12 +141,14 @@ class FallSink : public Sink {
 
   /// run.json's "falls" object as JSON text: {"rule": "...", "tilt_threshold_deg",
   /// "min_duration_sec", "robots": {NAME: {"base_body", "fell", "fall_time_sec" (null when
-  /// it did not fall), "max_tilt_deg", "max_tilt_time_sec"}}}.
+  /// it did not fall), "max_tilt_deg", "max_tilt_time_sec", "start_drop_m",
+  /// "start_tilt_change_deg", "stumbled_at_start"}}} (the start figures: StartRule's window).
   std::string SummaryJson() const;
 
  private:
   std::vector<FallTarget> targets_;
   std::vector<FallDetector> detectors_;
+  std::vector<StartCheck> starts_;
   FallRule rule_;
 };
 
