@@ -1,5 +1,6 @@
-// the physics benchmark runs both loops over the same number of steps (no timing
-// assertions: timings never decide pass/fail).
+// the physics benchmark runs its loops over the same number of steps, and the memory
+// comparison's bare loop and peak reading work (no timing or size assertions: measurements
+// never decide pass/fail).
 
 #include "penumbra/physics/physics_benchmark.h"
 
@@ -23,9 +24,17 @@ TEST(PhysicsBenchmark, RunsBothLoopsForTheRequestedSimTime) {
   EXPECT_EQ(r.steps, 200);
   EXPECT_GT(r.penumbra_steps_per_sec, 0);
   EXPECT_GT(r.bare_steps_per_sec, 0);
+  EXPECT_GT(r.step_only_steps_per_sec, 0);
   EXPECT_NEAR(r.ratio, r.penumbra_steps_per_sec / r.bare_steps_per_sec, 1e-12);
+  EXPECT_NEAR(r.step_only_ratio, r.step_only_steps_per_sec / r.bare_steps_per_sec, 1e-12);
   EXPECT_THROW(BenchmarkPhysics(path, 0), ConfigError);
   EXPECT_THROW(BenchmarkPhysics("/nonexistent.xml", 1), ConfigError);
+
+  EXPECT_EQ(RunBareMujocoLoop(path, 1.0), 200);
+  EXPECT_THROW(RunBareMujocoLoop(path, -1), ConfigError);
+  EXPECT_THROW(RunBareMujocoLoop("/nonexistent.xml", 1), ConfigError);
+  // this test process has touched at least its own code and MuJoCo's
+  EXPECT_GT(PeakResidentKiB(), 1024);
 }
 
 }  // namespace

@@ -94,7 +94,11 @@ class BenchPhysicsCommand : public Command {
 
   void AddOptions(CLI::App* verb) override {
     verb->add_option("--world", options_.world_file, "world file (default: bundled default world)");
-    verb->add_option("--model", options_.model_file, "bare MJCF model instead of a world");
+    verb->add_option("--model", options_.model_file,
+                     "bare MJCF model, stepped and its peak memory compared with MuJoCo alone "
+                     "(the world too when --world is given)");
+    // internal: the child processes of the memory comparison
+    verb->add_option("--memory-child", options_.memory_child)->group("");
     AddDecimal(
         verb, "--seconds", [this](double v) { options_.sim_seconds = v; }, 0, true,
         "simulated seconds per side");

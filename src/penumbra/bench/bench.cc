@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <string>
@@ -234,10 +235,87 @@ int BenchRender(const RenderBenchOptions& options) {
   return 0;
 }
 
+// "penumbra bench physics" steps of one model both ways, with its verdict line
+void PrintPhysicsThroughput(const std::string& label, const std::string& model, double seconds) {
+  const PhysicsBenchResult r = BenchmarkPhysics(model, seconds);
+  fmt::print("{}\n", label);
+  fmt::print("  {} steps of {:.1f} s sim time each way, interleaved in blocks of 250\n", r.steps,
+             seconds);
+  fmt::print("  penumbra Simulation::Step + 30 Hz pose snapshots: {:.0f} steps/s\n",
+             r.penumbra_steps_per_sec);
+  fmt::print("  penumbra Simulation::Step alone: {:.0f} steps/s (ratio {:.3f})\n",
+             r.step_only_steps_per_sec, r.step_only_ratio);
+  fmt::print("  bare mj_step loop: {:.0f} steps/s\n", r.bare_steps_per_sec);
+  fmt::print("  ratio: {:.3f} (target >= {:.2f}: {})\n", r.ratio, kPhysicsThroughputTarget,
+             TargetVerdict(r.ratio, kPhysicsThroughputTarget));
+}
+
+// shell-quoted for popen
+std::string ShellQuoted(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// runs this executable as a memory child and returns its "vm_hwm_kib" line's value
+int64_t MemoryChildKiB(const std::string& mode, const std::string& model, double seconds) {
+  const std::string exe = std::filesystem::read_symlink("/proc/self/exe").string();
+  const std::string cmd = ShellQuoted(exe) + " bench physics --memory-child " + mode + " --model " +
+                          ShellQuoted(model) +
+                          fmt::format(" --seconds {} --no-controllers", seconds);
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (p == nullptr) throw Error("bench physics: cannot run " + cmd);
+  std::string out;
+  char buf[4096];
+  while (std::fgets(buf, sizeof(buf), p)) out += buf;
+  const int status = ::pclose(p);
+  const size_t at = out.rfind("vm_hwm_kib ");
+  if (status != 0 || at == std::string::npos)
+    throw Error("bench physics: the memory child '" + mode + "' failed (" + cmd + "):\n" + out);
+  return std::stoll(out.substr(at + 11));
+}
+
+// the memory child's work: see PhysicsBenchOptions::memory_child
+int RunMemoryChild(const PhysicsBenchOptions& options) {
+  const std::string& mode = options.memory_child;
+  if (mode == "bare") {
+    RunBareMujocoLoop(options.model_file, options.sim_seconds);
+  } else if (mode == "penumbra") {
+    // a bare model's run without cameras: the session (composition, physics, scene), stepped
+    // with a pose snapshot at 30 Hz of sim time as the run loop takes them
+    const WorldConfig world = WorldForBareModel(options.model_file);
+    SessionOptions session_options;
+    session_options.composed_xml_path = BenchComposedPath();
+    session_options.build_renderer = false;
+    Session session(world, session_options);
+    Simulation& sim = session.sim();
+    const int64_t total = std::max<int64_t>(1, std::llround(options.sim_seconds / sim.timestep()));
+    WorldSnapshot snapshot;
+    int64_t next_frame = 0;
+    for (int64_t i = 0; i < total; ++i) {
+      sim.Step();
+      if (sim.time() + 1e-6 * sim.timestep() >= next_frame / 30.0) {
+        sim.Snapshot(&snapshot, Simulation::SnapshotContent::kPoses);
+        ++next_frame;
+      }
+    }
+  } else if (mode != "idle") {
+    throw ConfigError("", 0, "--memory-child",
+                      "got '" + mode + "'; expected idle, bare or penumbra");
+  }
+  fmt::print("vm_hwm_kib {}\n", PeakResidentKiB());
+  return 0;
+}
+
 int BenchPhysics(const PhysicsBenchOptions& options) {
-  std::string model = options.model_file;
-  std::string label = model;
-  if (model.empty()) {
+  if (!options.memory_child.empty()) return RunMemoryChild(options);
+  fmt::print("penumbra bench physics on {}\n", ThisMachine().Describe());
+  if (!options.model_file.empty()) {
+    // both ways first: the model must load in MuJoCo alone
+    PrintPhysicsThroughput(options.model_file + " (bare model)", options.model_file,
+                           options.sim_seconds);
+  }
+  if (options.model_file.empty() || !options.world_file.empty()) {
     WorldConfig world =
         LoadWorldFile(options.world_file.empty() ? DefaultWorldPath() : options.world_file);
     SessionOptions session_options;
@@ -245,15 +323,41 @@ int BenchPhysics(const PhysicsBenchOptions& options) {
     session_options.add_controllers = false;
     session_options.build_renderer = false;
     const Session session(world, session_options);  // writes the composed model
-    model = session_options.composed_xml_path;
-    label = world.file + " (composed, no controllers)";
+    PrintPhysicsThroughput(world.file + " (composed, no controllers)",
+                           session_options.composed_xml_path, options.sim_seconds);
   }
-  const PhysicsBenchResult r = BenchmarkPhysics(model, options.sim_seconds);
-  fmt::print("penumbra bench physics: {}\n", label);
-  fmt::print("{} steps of {:.1f} s sim time each way\n", r.steps, options.sim_seconds);
-  fmt::print("penumbra Simulation::Step: {:.0f} steps/s\n", r.penumbra_steps_per_sec);
-  fmt::print("bare mj_step loop:         {:.0f} steps/s\n", r.bare_steps_per_sec);
-  fmt::print("ratio: {:.3f} (target >= 0.95: {})\n", r.ratio, TargetVerdict(r.ratio, 0.95));
+  if (!options.model_file.empty()) {
+    // peak memory, each in a fresh process of this executable (the same libraries on all
+    // three), interleaved twice; the smaller of each pair
+    const std::string& model = options.model_file;
+    const double s = options.sim_seconds;
+    int64_t idle = 0, bare = 0, pen = 0;
+    for (int round = 0; round < 2; ++round) {
+      const int64_t i = MemoryChildKiB("idle", model, s);
+      const int64_t b = MemoryChildKiB("bare", model, s);
+      const int64_t p = MemoryChildKiB("penumbra", model, s);
+      idle = round == 0 ? i : std::min(idle, i);
+      bare = round == 0 ? b : std::min(bare, b);
+      pen = round == 0 ? p : std::min(pen, p);
+    }
+    const double mib = 1.0 / 1024;
+    const double above_bare = static_cast<double>(bare - idle),
+                 above_pen = static_cast<double>(pen - idle);
+    const double ratio = above_bare > 0 ? above_pen / above_bare : 0;
+    fmt::print("peak resident memory (VmHWM) of {} s of {}, fresh processes of this executable:\n",
+               s, model);
+    fmt::print("  libraries only (no model):         {:7.1f} MiB\n", idle * mib);
+    fmt::print(
+        "  bare mj_step loop (MuJoCo alone):  {:7.1f} MiB ({:.1f} MiB above the libraries)\n",
+        bare * mib, above_bare * mib);
+    fmt::print(
+        "  penumbra session, no cameras:      {:7.1f} MiB ({:.1f} MiB above the libraries)\n",
+        pen * mib, above_pen * mib);
+    fmt::print(
+        "  ratio above the libraries: {:.2f} (target <= {:.1f}: {}); whole processes: {:.2f}\n",
+        ratio, kPhysicsMemoryTarget, ratio > 0 && ratio <= kPhysicsMemoryTarget ? "met" : "NOT met",
+        bare > 0 ? static_cast<double>(pen) / bare : 0.0);
+  }
 
   // controller cost on every bundled world with controllers
   if (options.controllers) {

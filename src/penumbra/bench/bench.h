@@ -53,13 +53,28 @@ int BenchRender(const RenderBenchOptions& options);
 /// options of `penumbra bench physics`.
 struct PhysicsBenchOptions {
   std::string world_file;  ///< world whose composed model is stepped (default world)
-  std::string model_file;  ///< or a bare MJCF file
+  /// a bare MJCF file, stepped as well (the default world is then not measured unless
+  /// world_file is given); its peak memory is compared with MuJoCo alone
+  std::string model_file;
   double sim_seconds = 20;
   bool controllers = true;         ///< also report controller cost on the bundled robot worlds
   double controller_seconds = 10;  ///< simulated seconds per controller-cost episode
+  /// internal: this process is a child of the memory comparison: "idle" (nothing), "bare"
+  /// (RunBareMujocoLoop) or "penumbra" (a session of the model, stepped); it prints
+  /// "vm_hwm_kib <n>" and exits
+  std::string memory_child;
 };
 
-/// prints Penumbra's physics steps/s against a bare mj_step loop on the same model. returns 0.
+/// the ratio target of `bench physics`: Penumbra's steps/s over a bare mj_step loop's.
+inline constexpr double kPhysicsThroughputTarget = 0.98;
+/// the memory target: a bare model's session peak memory above that of the libraries, over the
+/// same for a bare mj_step loop (both fresh processes of this executable).
+inline constexpr double kPhysicsMemoryTarget = 2.0;
+
+/// prints the machine, then Penumbra's physics steps/s against a bare mj_step loop on the same
+/// model for the world (composed, no controllers) and the model, and, for a model, the peak
+/// resident memory of three fresh processes of this executable (libraries only, a bare mj_step
+/// loop, a session of the model stepped as a run steps it with no cameras). returns 0.
 int BenchPhysics(const PhysicsBenchOptions& options);
 
 /// the frame rate `penumbra bench render` aims for: 640x480 rgb+depth, realtime tier, on the
