@@ -63,15 +63,8 @@ class WorldParser {
       const ParamReader& p = *physics;
       p.ExpectMapAnyKeys();
       if (const auto found = p.Find("timestep_sec")) w.timestep_sec = found->Double();
-      if (const auto integrator = p.Find("integrator")) {
-        const ParamReader& i = *integrator;
-        if (i.String() == "implicitfast") {
-          i.Fail(
-              "'implicitfast' is newer than MuJoCo 2.2.2 (Penumbra's physics); expected one of: "
-              "Euler, RK4, implicit (implicit is implicitfast with the Coriolis terms kept)");
-        }
-        w.physics.integrator = i.Enum({"Euler", "RK4", "implicit"});
-      }
+      if (const auto found = p.Find("integrator"))
+        w.physics.integrator = found->Enum({"Euler", "RK4", "implicit", "implicitfast"});
       if (const auto found = p.Find("gravity_mps2")) w.physics.gravity_mps2 = found->Vector3();
       if (const auto found = p.Find("solver_iterations"))
         w.physics.solver_iterations = found->Int();

@@ -67,10 +67,11 @@ struct ModelConfig {
 };
 
 /// world-file `physics:` options besides timestep_sec. each one that is set overrides the
-/// composed MJCF's <option> attribute of the same meaning (MuJoCo 2.2.2 XML reference,
-/// <option>); unset ones keep the first model's <option> (compose/scene_composer.h).
+/// composed MJCF's <option> attribute of the same meaning (MuJoCo 4.0 XML reference,
+/// <option>); unset ones keep the models' <option> (compose/scene_composer.h).
 struct PhysicsOptions {
-  /// <option integrator>: "Euler", "RK4" or "implicit" (MuJoCo 2.2.2's integrators).
+  /// <option integrator>: "Euler", "RK4", "implicit" or "implicitfast" (implicit without the
+  /// Coriolis and centripetal derivatives: cheaper, what MuJoCo recommends for robots).
   std::optional<std::string> integrator;
   /// <option gravity>, m/s^2 in the world frame W (z up); each component in [-1000, 1000].
   std::optional<Eigen::Vector3d> gravity_mps2;

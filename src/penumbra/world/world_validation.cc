@@ -74,9 +74,10 @@ class Validator {
     if (w_.physics.solver_iterations)
       Check("physics.solver_iterations", *w_.physics.solver_iterations, Range::Closed(1, 10000));
     if (w_.physics.integrator && *w_.physics.integrator != "Euler" &&
-        *w_.physics.integrator != "RK4" && *w_.physics.integrator != "implicit")
-      Fail("physics.integrator",
-           "unknown value '" + *w_.physics.integrator + "'; expected one of: Euler, RK4, implicit");
+        *w_.physics.integrator != "RK4" && *w_.physics.integrator != "implicit" &&
+        *w_.physics.integrator != "implicitfast")
+      Fail("physics.integrator", "unknown value '" + *w_.physics.integrator +
+                                     "'; expected one of: Euler, RK4, implicit, implicitfast");
     if (w_.physics.cone && *w_.physics.cone != "pyramidal" && *w_.physics.cone != "elliptic")
       Fail("physics.cone",
            "unknown value '" + *w_.physics.cone + "'; expected one of: pyramidal, elliptic");

@@ -1,0 +1,43 @@
+// the world file's physics options reach the composed model that MuJoCo compiles and that
+// composed.xml holds (a replay loads that file): MuJoCo 3's implicitfast integrator included.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "common/temp_dir.h"
+#include "penumbra/session/session.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+namespace {
+
+TEST(PhysicsOptionsSession, ImplicitfastFromTheWorldFileIsTheComposedModelsIntegrator) {
+  penumbra::testing::TempDir dir;
+  dir.Write("box.xml",
+            "<mujoco><worldbody><geom type=\"plane\" size=\"2 2 0.1\"/>"
+            "<body pos=\"0 0 0.5\"><freejoint/><geom type=\"box\" size=\"0.1 0.1 0.1\"/></body>"
+            "</worldbody></mujoco>\n");
+  const std::string world = dir.Write("world.yaml",
+                                      "physics: {integrator: implicitfast, cone: elliptic}\n"
+                                      "models:\n"
+                                      "  - name: box\n"
+                                      "    file: box.xml\n");
+  SessionOptions options;
+  options.build_renderer = false;
+  options.composed_xml_path = dir.str() + "/composed.xml";
+  Session session(LoadWorldFile(world), options);
+  std::ifstream in(options.composed_xml_path);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("integrator=\"implicitfast\""), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("cone=\"elliptic\""), std::string::npos) << text.str();
+  // and it steps: the box falls onto the plane and rests there
+  Simulation& sim = session.sim();
+  while (sim.time() < 1.0) sim.Step();
+  EXPECT_NEAR(sim.Snapshot().X_WB.back().translation().z(), 0.1, 0.01);
+}
+
+}  // namespace
+}  // namespace penumbra
