@@ -18,19 +18,19 @@
 namespace penumbra {
 namespace {
 
-double DistanceToSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
-                         const Eigen::Vector2d& b) {
+double DistanceToRouteSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                              const Eigen::Vector2d& b) {
   const Eigen::Vector2d ab = b - a;
   const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
   return (p - (a + t * ab)).norm();
 }
 
-double Yaw(const Pose& X) { return std::atan2(X.linear()(1, 0), X.linear()(0, 0)); }
+double TrunkYaw(const Pose& X) { return std::atan2(X.linear()(1, 0), X.linear()(0, 0)); }
 
 // runs worlds/<name>.yaml for its duration without a renderer, calling `each` after every
 // step with the pose of `body`; returns that pose at the end.
-Pose RunWorld(const std::string& name, const std::string& body,
-              const std::function<void(double, const Pose&)>& each) {
+Pose RunExampleWorld(const std::string& name, const std::string& body,
+                     const std::function<void(double, const Pose&)>& each) {
   const WorldConfig world = LoadWorldFile(PENUMBRA_SOURCE_DIR "/worlds/" + name + ".yaml");
   SessionOptions options;
   options.build_renderer = false;
@@ -53,9 +53,9 @@ Pose RunWorld(const std::string& name, const std::string& body,
 void ExpectRampCourse(const std::string& name, const std::string& trunk, double turn_deg,
                       double stand_height_m) {
   double min_up = 1;
-  const Pose X = RunWorld(
+  const Pose X = RunExampleWorld(
       name, trunk, [&](double, const Pose& p) { min_up = std::min(min_up, p.linear()(2, 2)); });
-  const double yaw_deg = Yaw(X) * 180 / M_PI;
+  const double yaw_deg = TrunkYaw(X) * 180 / M_PI;
   std::printf(
       "[ measured ] %s: trunk ends at (%.2f, %.2f, %.3f) m, yaw %.1f deg, up-axis z >= %.3f\n",
       name.c_str(), X.translation().x(), X.translation().y(), X.translation().z(), yaw_deg, min_up);
@@ -82,14 +82,14 @@ TEST(RobotWorlds, RoverDrivesItsLoopThroughTheRoom) {
   size_t next = 0;
   double path_m = 0, max_off_m = 0, min_up = 1, last_at = -1;
   Eigen::Vector2d last(-0.2, -1.45);
-  RunWorld("rover", "rover/chassis", [&](double t, const Pose& X) {
+  RunExampleWorld("rover", "rover/chassis", [&](double t, const Pose& X) {
     const Eigen::Vector2d p = X.translation().head<2>();
     path_m += (p - last).norm();
     last = p;
     min_up = std::min(min_up, X.linear()(2, 2));
     double off = 1e9;
     for (size_t k = 0; k < route.size(); ++k)
-      off = std::min(off, DistanceToSegment(p, route[k], route[(k + 1) % route.size()]));
+      off = std::min(off, DistanceToRouteSegment(p, route[k], route[(k + 1) % route.size()]));
     max_off_m = std::max(max_off_m, off);
     if (next < route.size() && (p - route[next]).norm() < 0.15) {
       ++next;
@@ -110,7 +110,7 @@ TEST(RobotWorlds, QuadrotorFliesItsSquareAndLandsOnThePad) {
   const std::vector<Eigen::Vector3d> c = {
       {0, 0, 1.5}, {4, 0, 1.5}, {4, 4, 1.5}, {0, 4, 1.5}, {0, 0, 1.5}};
   double max_off_m = 0;
-  const Pose X = RunWorld("quadrotor", "drone/base", [&](double t, const Pose& p) {
+  const Pose X = RunExampleWorld("quadrotor", "drone/base", [&](double t, const Pose& p) {
     if (t < 4.0 || t > 24.0) return;  // the square is flown from t = 4 s
     double off = 1e9;
     for (size_t k = 0; k + 1 < c.size(); ++k) {
@@ -131,7 +131,7 @@ TEST(RobotWorlds, QuadrotorFliesItsSquareAndLandsOnThePad) {
 
 TEST(RobotWorlds, ArmPutsTheCubeOnTheMarker) {
   // the table scene is placed 0.75 m up; the marker is at (0.5, 0.15) in the arm's base frame
-  const Pose X = RunWorld("arm", "arm/cube", [](double, const Pose&) {});
+  const Pose X = RunExampleWorld("arm", "arm/cube", [](double, const Pose&) {});
   const Eigen::Vector2d marker(0.5, 0.15);
   const double off = (X.translation().head<2>() - marker).norm();
   std::printf(
