@@ -25,12 +25,12 @@ const std::string kWrappers = PENUMBRA_SOURCE_DIR "/worlds/models/menagerie";
 const std::string kMjlabRobots =
     PENUMBRA_SOURCE_DIR "/.venv/lib/python3.11/site-packages/mjlab/asset_zoo/robots";
 
-bool MjlabInstalled(const std::string& robot_xml) {
+bool MjlabRobotInstalled(const std::string& robot_xml) {
   return std::filesystem::exists(kMjlabRobots + "/" + robot_xml);
 }
 
 // the wrapper `file` with a floor added to its world body, loaded with its keyframe "home".
-Simulation LoadOnFloor(const std::string& file) {
+Simulation LoadMjlabOnFloor(const std::string& file) {
   std::ifstream f(kWrappers + "/" + file);
   std::stringstream ss;
   ss << f.rdbuf();
@@ -43,29 +43,29 @@ Simulation LoadOnFloor(const std::string& file) {
   return sim;
 }
 
-Pose BodyPose(const Simulation& sim, int body) {
+Pose MjlabBodyPose(const Simulation& sim, int body) {
   WorldSnapshot snap;
   sim.Snapshot(&snap);
   return snap.X_WB[body];
 }
 
 TEST(MenagerieMjlab, Go1StandsOnItsServosFromItsKeyframe) {
-  if (!MjlabInstalled("unitree_go1/xmls/go1.xml"))
+  if (!MjlabRobotInstalled("unitree_go1/xmls/go1.xml"))
     GTEST_SKIP() << "mjlab 1.6.0 is not installed in " << kMjlabRobots
                  << " (scripts/install-deps.sh installs it)";
-  Simulation sim = LoadOnFloor("unitree_go1.xml");
+  Simulation sim = LoadMjlabOnFloor("unitree_go1.xml");
   const int trunk = sim.scene().FindBody("trunk");
   ASSERT_GE(trunk, 0);
-  EXPECT_NEAR(BodyPose(sim, trunk).translation().z(), 0.278, 1e-9);  // mjlab's INIT_STATE
+  EXPECT_NEAR(MjlabBodyPose(sim, trunk).translation().z(), 0.278, 1e-9);  // mjlab's INIT_STATE
   double min_z = 1e9, max_z = 0, min_up = 1;
   while (sim.time() < 5.0 - 1e-9) {
     sim.Step();
-    const Pose X = BodyPose(sim, trunk);
+    const Pose X = MjlabBodyPose(sim, trunk);
     min_z = std::min(min_z, X.translation().z());
     max_z = std::max(max_z, X.translation().z());
     min_up = std::min(min_up, X.linear()(2, 2));
   }
-  const Pose X = BodyPose(sim, trunk);
+  const Pose X = MjlabBodyPose(sim, trunk);
   std::printf(
       "[ measured ] Go1 (mjlab) holding its key for 5 s: trunk z in [%.3f, %.3f] m, ends at "
       "%.3f m, up-axis z >= %.4f (tilt <= %.1f deg), moved %.3f m\n",
@@ -80,10 +80,10 @@ TEST(MenagerieMjlab, Go1StandsOnItsServosFromItsKeyframe) {
 }
 
 TEST(MenagerieMjlab, TrotGaitWalksTheGo1OnItsPositionServos) {
-  if (!MjlabInstalled("unitree_go1/xmls/go1.xml"))
+  if (!MjlabRobotInstalled("unitree_go1/xmls/go1.xml"))
     GTEST_SKIP() << "mjlab 1.6.0 is not installed in " << kMjlabRobots
                  << " (scripts/install-deps.sh installs it)";
-  Simulation sim = LoadOnFloor("unitree_go1.xml");
+  Simulation sim = LoadMjlabOnFloor("unitree_go1.xml");
   std::string config = "base_body: trunk\nlegs:\n";
   for (const char* leg : {"FR", "FL", "RR", "RL"}) {
     const std::string l = leg;
@@ -93,13 +93,13 @@ TEST(MenagerieMjlab, TrotGaitWalksTheGo1OnItsPositionServos) {
   config += "commands: [{t: 0, vx: 0.5}, {t: 6, vx: 0}]\n";
   sim.AddController(MakeController({"trot_gait", ParseYaml(config), 1}, "", "test.yaml"));
   const int trunk = sim.scene().FindBody("trunk");
-  const Eigen::Vector3d p0 = BodyPose(sim, trunk).translation();
+  const Eigen::Vector3d p0 = MjlabBodyPose(sim, trunk).translation();
   double min_up = 1;
   while (sim.time() < 7.0 - 1e-9) {
     sim.Step();
-    min_up = std::min(min_up, BodyPose(sim, trunk).linear()(2, 2));
+    min_up = std::min(min_up, MjlabBodyPose(sim, trunk).linear()(2, 2));
   }
-  const Pose X = BodyPose(sim, trunk);
+  const Pose X = MjlabBodyPose(sim, trunk);
   const Eigen::Vector3d d = X.translation() - p0;
   std::printf(
       "[ measured ] Go1 (mjlab) trot_gait 0.5 m/s for 6 s: dx = %.3f m, dy = %.3f m, trunk z "
@@ -112,21 +112,21 @@ TEST(MenagerieMjlab, TrotGaitWalksTheGo1OnItsPositionServos) {
 }
 
 TEST(MenagerieMjlab, G1HoldingItsKeyframePoseWithMjlabGainsTipsOver) {
-  if (!MjlabInstalled("unitree_g1/xmls/g1.xml"))
+  if (!MjlabRobotInstalled("unitree_g1/xmls/g1.xml"))
     GTEST_SKIP() << "mjlab 1.6.0 is not installed in " << kMjlabRobots
                  << " (scripts/install-deps.sh installs it)";
-  Simulation sim = LoadOnFloor("unitree_g1.xml");
+  Simulation sim = LoadMjlabOnFloor("unitree_g1.xml");
   const int pelvis = sim.scene().FindBody("pelvis");
   ASSERT_GE(pelvis, 0);
   double tipped_at = -1;
   double z_at_half = 0;
   while (sim.time() < 2.0 - 1e-9) {
     sim.Step();
-    const Pose X = BodyPose(sim, pelvis);
+    const Pose X = MjlabBodyPose(sim, pelvis);
     if (std::abs(sim.time() - 0.5) < 1e-9) z_at_half = X.translation().z();
     if (tipped_at < 0 && X.linear()(2, 2) < std::cos(30 * M_PI / 180)) tipped_at = sim.time();
   }
-  const Pose X = BodyPose(sim, pelvis);
+  const Pose X = MjlabBodyPose(sim, pelvis);
   std::printf(
       "[ measured ] G1 (mjlab) holding its key: pelvis z %.3f m at 0.5 s, tilted past 30 deg "
       "at %.2f s, pelvis z %.3f m at 2 s\n",
