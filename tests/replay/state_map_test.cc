@@ -265,5 +265,23 @@ TEST(StateMap, AnotherCountOfThemThanTheLogsIsRefusedNamingIt) {
       << ErrorOf(log, m);
 }
 
+// MuJoCo 4: a stateful actuator need not come last and may hold several activations (a pid
+// with slew and integral, actdim 2): the same actuators copy ctrl and act whole
+TEST(StateMap, TheSameActuatorsCopyEveryActivationWhereverItIs) {
+  RunLogLayout l = RecordedLayout();
+  l.actuator_names = {"r/pid"};  // one actuator, two activations
+  l.nu = 1, l.na = 2;
+  RunLogLayout m = l;
+  m.mocap_body_names = {"adversity_person0", "npc0"};  // an added agent: not the same layout
+  m.nmocap = 2;
+  const StateMap map(l, m, "run.plog");
+  EXPECT_FALSE(map.identity());
+  const StepRecord r = RecordOf(l, 5);
+  SimState s = EmptyState(m);
+  map.Apply(r, &s);
+  EXPECT_EQ(s.act, (std::vector<double>{300, 301}));
+  EXPECT_EQ(s.ctrl, std::vector<double>{400});
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -45,7 +45,7 @@ std::string EntryOwner(const RunLogLayout& l, StateField field, int64_t i) {
   };
   const auto named = [](const std::vector<std::string>& names, int64_t k, const char* kind,
                         int64_t width, const char* const* parts) -> std::string {
-    if (k / width >= static_cast<int64_t>(names.size())) return "";
+    if (k < 0 || k / width >= static_cast<int64_t>(names.size())) return "";
     return std::string(kind) + " '" + names[k / width] + "'" +
            (parts ? std::string(" ") + parts[k % width] : "");
   };
@@ -53,9 +53,9 @@ std::string EntryOwner(const RunLogLayout& l, StateField field, int64_t i) {
   static const char* const kWxyz[] = {"w", "x", "y", "z"};
   static const char* const kWrench[] = {"torque x", "torque y", "torque z",
                                         "force x",  "force y",  "force z"};
-  // by what the field's entries index (its dimension), act being the last na actuators
-  if (field == StateField::kAct)
-    return named(l.actuator_names, i + (l.nu - l.na), "actuator", 1, nullptr);
+  // by what the field's entries index (its dimension). act: the layout does not say which
+  // actuator an activation belongs to (MuJoCo 4's actuator_actadr), so it is not named
+  if (field == StateField::kAct) return "";
   switch (StateFieldOf(field).dim) {
     case StateDim::kNq:
       return joint(true);

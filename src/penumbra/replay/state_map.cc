@@ -122,28 +122,39 @@ StateMap::StateMap(const RunLogLayout& log, const RunLogLayout& model, const std
       fail("the replay model has " + Quoted(model.joints[j].name, "joint", j) +
            ", which the log does not record" + kFixed);
 
-  // actuators: ctrl, and act of the stateful ones (the last na actuators)
-  const std::vector<int> act_to = MatchNames(log.actuator_names, model.actuator_names);
-  std::vector<char> model_act_seen(model.actuator_names.size(), 0);
-  for (size_t i = 0; i < log.actuator_names.size(); ++i) {
-    if (act_to[i] < 0)
-      fail("the replay model has no " + Quoted(log.actuator_names[i], "actuator", i) +
-           " that the log records" + kFixed);
-    const int b = act_to[i];
-    model_act_seen[b] = 1;
-    AddSpan(&Spans(StateDim::kNu), static_cast<int>(i), b, 1);
-    const int log_act = static_cast<int>(i) - (log.nu - log.na);
-    const int model_act = b - (model.nu - model.na);
-    if ((log_act >= 0) != (model_act >= 0))
-      fail("the replay model's " + Quoted(log.actuator_names[i], "actuator", i) +
-           (model_act >= 0 ? " has" : " has no") + " activation state; the log records it " +
-           (log_act >= 0 ? "with" : "without") + " one" + kFixed);
-    if (log_act >= 0) AddSpan(&Spans(StateDim::kNa), log_act, model_act, 1);
+  // actuators: ctrl and act. the same actuators in the same order with the same nu and na (a
+  // replay changes no robot) copy both whole: MuJoCo 4 puts a stateful actuator anywhere and
+  // gives it one or more activations (actuator_actadr / actnum, which the layout does not
+  // hold). otherwise actuator by actuator: one ctrl each, act for the last na actuators, one
+  // activation each (MuJoCo 2.2.2's order)
+  const bool same_actuators =
+      log.actuator_names == model.actuator_names && log.nu == model.nu && log.na == model.na;
+  if (same_actuators) {
+    AddSpan(&Spans(StateDim::kNu), 0, 0, log.nu);
+    AddSpan(&Spans(StateDim::kNa), 0, 0, log.na);
+  } else {
+    const std::vector<int> act_to = MatchNames(log.actuator_names, model.actuator_names);
+    std::vector<char> model_act_seen(model.actuator_names.size(), 0);
+    for (size_t i = 0; i < log.actuator_names.size(); ++i) {
+      if (act_to[i] < 0)
+        fail("the replay model has no " + Quoted(log.actuator_names[i], "actuator", i) +
+             " that the log records" + kFixed);
+      const int b = act_to[i];
+      model_act_seen[b] = 1;
+      AddSpan(&Spans(StateDim::kNu), static_cast<int>(i), b, 1);
+      const int log_act = static_cast<int>(i) - (log.nu - log.na);
+      const int model_act = b - (model.nu - model.na);
+      if ((log_act >= 0) != (model_act >= 0))
+        fail("the replay model's " + Quoted(log.actuator_names[i], "actuator", i) +
+             (model_act >= 0 ? " has" : " has no") + " activation state; the log records it " +
+             (log_act >= 0 ? "with" : "without") + " one" + kFixed);
+      if (log_act >= 0) AddSpan(&Spans(StateDim::kNa), log_act, model_act, 1);
+    }
+    for (size_t a = 0; a < model.actuator_names.size(); ++a)
+      if (!model_act_seen[a])
+        fail("the replay model has " + Quoted(model.actuator_names[a], "actuator", a) +
+             ", which the log does not record" + kFixed);
   }
-  for (size_t a = 0; a < model.actuator_names.size(); ++a)
-    if (!model_act_seen[a])
-      fail("the replay model has " + Quoted(model.actuator_names[a], "actuator", a) +
-           ", which the log does not record" + kFixed);
 
   if (log.nuserdata != model.nuserdata)
     fail("the replay model has " + std::to_string(model.nuserdata) +

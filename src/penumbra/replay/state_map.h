@@ -10,8 +10,11 @@
 //                  every field of size nv (scene/sim_state.h) are copied joint by joint. a missing
 //                  joint or a changed width is an error naming it (robots and models cannot change
 //                  in a replay).
-//   actuators      the same, for ctrl and act (MuJoCo 2.2.2 keeps act[i] for actuator
-//                  nu - na + i, the stateful actuators last).
+//   actuators      the same, for ctrl and act: with the same actuators in the same order and
+//                  the same nu and na, both are copied whole (MuJoCo 4 puts stateful actuators
+//                  anywhere, with one or more activations each); otherwise one ctrl per
+//                  actuator and act[i] for actuator nu - na + i (MuJoCo 2.2.2's order, the
+//                  stateful actuators last).
 //   mocap bodies   those of the log are copied into the replay model's mocap body of the same
 //                  name (recorded agents follow the log); a logged mocap body the replay model
 //                  lacks is dropped (e.g. a replay under --adversity none of a run recorded
