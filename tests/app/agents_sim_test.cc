@@ -7,7 +7,7 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/compose/agent_bodies.h"
-#include "penumbra/compose/scene_composer.h"
+#include "penumbra/session/world_composer.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/session/effects_stage.h"

@@ -13,7 +13,7 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/run/runner.h"
-#include "penumbra/compose/scene_composer.h"
+#include "penumbra/session/world_composer.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/control/trot_gait.h"
 #include "penumbra/physics/simulation.h"

@@ -7,12 +7,11 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/app/cli.h"
-#include "penumbra/compose/scene_composer.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
-#include "penumbra/physics/urdf_converter.h"
 #include "penumbra/run/runner.h"
 #include "penumbra/session/floor_map.h"
+#include "penumbra/session/world_composer.h"
 
 namespace penumbra {
 namespace {
@@ -28,7 +27,6 @@ Planned Plan(const std::string& preset, uint64_t seed) {
   WorldConfig world = LoadWorldFile(kDefaultWorld);
   world.seed = seed;
   ComposeOptions opts;
-  opts.urdf_to_mjcf = ConvertUrdfToMjcf;
   ComposedScene composed = ComposeWorld(world.models, opts);
   EffectsStage stage(world, &composed, preset);
   return {stage.effects(), stage.agents()};
@@ -79,7 +77,6 @@ TEST(AdversityPlan, NpcPathsAreClearOfFurnitureAndTheRobotAndDependOnTheSeed) {
   // at least 1.5 m from the robot
   WorldConfig world = LoadWorldFile(kDefaultWorld);
   ComposeOptions opts;
-  opts.urdf_to_mjcf = ConvertUrdfToMjcf;
   const ComposedScene composed = ComposeWorld(world.models, opts);
   Simulation sim = Simulation::LoadFromString(composed.Xml());
   const FloorMap map(sim.scene(), sim.Snapshot().X_WB, 0.0, Eigen::Vector2d(-0.2, -1.45));
@@ -139,7 +136,6 @@ TEST(AdversityPlan, CliRunWithAnUnknownPresetExitsWith2AndAKnownOneRecordsIt) {
 TEST(AdversityPlan, EffectsAreEvaluatedDeterministically) {
   WorldConfig world = LoadWorldFile(kDefaultWorld);
   ComposeOptions opts;
-  opts.urdf_to_mjcf = ConvertUrdfToMjcf;
   ComposedScene composed = ComposeWorld(world.models, opts);
   EffectsStage stage(world, &composed, "major");
   Simulation sim = Simulation::LoadFromString(composed.Xml());

@@ -12,7 +12,7 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/compose/agent_bodies.h"
-#include "penumbra/compose/scene_composer.h"
+#include "penumbra/session/world_composer.h"
 #include "penumbra/effects/agent_animation.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/ray_query.h"

@@ -1,5 +1,5 @@
 // issue 17 point 6: a bare URDF (`penumbra run robot.urdf`) gets a ground plane, as a bare
-// model gets lights and a camera; URDF meshes MuJoCo 2.2.2 cannot read are converted next
+// model gets lights and a camera; URDF meshes MuJoCo cannot read are converted next
 // to the composed model.
 #include <gtest/gtest.h>
 
@@ -75,17 +75,18 @@ TEST(BareUrdf, BareMjcfAndModelsWithAPlaneGetNoExtraGround) {
 
 TEST(BareUrdf, DaeMeshesAreConvertedBesideTheComposedModel) {
   penumbra::testing::TempDir dir;
-  // a one-triangle COLLADA visual in millimetres
+  // a tetrahedron COLLADA visual in millimetres (MuJoCo refuses meshes of fewer than 4 vertices)
   dir.Write("meshes/tri.dae",
             R"(<?xml version="1.0"?>
 <COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
 <asset><unit meter="0.001"/><up_axis>Z_UP</up_axis></asset>
 <library_geometries><geometry id="g"><mesh>
-<source id="p"><float_array id="pa" count="9">0 0 0 100 0 0 0 100 50</float_array>
-<technique_common><accessor source="#pa" count="3" stride="3"><param name="X" type="float"/>
+<source id="p"><float_array id="pa" count="12">0 0 0 100 0 0 0 100 0 0 0 50</float_array>
+<technique_common><accessor source="#pa" count="4" stride="3"><param name="X" type="float"/>
 <param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common></source>
 <vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
-<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2</p></triangles>
+<triangles count="4"><input semantic="VERTEX" source="#v" offset="0"/><p>0 2 1 0 1 3 0 3 2 1 2 3</p>
+</triangles>
 </mesh></geometry></library_geometries>
 <library_visual_scenes><visual_scene id="s"><node id="n"><instance_geometry url="#g"/></node>
 </visual_scene></library_visual_scenes><scene><instance_visual_scene url="#s"/></scene>

@@ -1,33 +1,43 @@
 // EffectsStage compiles the composed model itself only for an adversity preset (its planner
 // needs the static scene); the world's own agents are checked against the run's model.
 #include <gtest/gtest.h>
+#include <tinyxml2.h>
 
 #include <string>
 
 #include "common/temp_dir.h"
-#include "penumbra/compose/scene_composer.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/session/effects_stage.h"
+#include "penumbra/session/world_composer.h"
 
 namespace penumbra {
 namespace {
 
-// composes (every name defined, every reference resolved) but MuJoCo refuses to compile it:
-// a moving body without mass
-constexpr const char* kMassless = R"(<mujoco model="massless">
+constexpr const char* kFloor = R"(<mujoco model="floor">
   <worldbody>
     <geom name="floor" type="plane" size="5 5 0.1"/>
-    <body name="ghost" pos="0 0 1"><joint name="hinge" type="hinge"/></body>
   </worldbody>
 </mujoco>)";
+
+// the composed floor with what MuJoCo refuses to compile: a moving body without mass
+ComposedScene ComposeMassless(const WorldConfig& world) {
+  ComposedScene composed = ComposeWorld(world.models, ComposeOptions{});
+  tinyxml2::XMLElement* worldbody =
+      composed.document->RootElement()->FirstChildElement("worldbody");
+  tinyxml2::XMLElement* ghost = worldbody->InsertNewChildElement("body");
+  ghost->SetAttribute("name", "ghost");
+  ghost->SetAttribute("pos", "0 0 1");
+  ghost->InsertNewChildElement("joint")->SetAttribute("name", "hinge");
+  return composed;
+}
 
 WorldConfig MasslessWorld(const penumbra::testing::TempDir& dir) {
   WorldConfig world;
   world.file = "w.yaml";
   ModelConfig m;
   m.name = "m";
-  m.file = dir.Write("massless.xml", kMassless);
+  m.file = dir.Write("floor.xml", kFloor);
   world.models.push_back(m);
   AgentConfig a;
   a.name = "walker";
@@ -40,7 +50,7 @@ WorldConfig MasslessWorld(const penumbra::testing::TempDir& dir) {
 TEST(EffectsStageCompile, AgentsWithoutAPresetDoNotCompileTheModel) {
   const penumbra::testing::TempDir dir;
   const WorldConfig world = MasslessWorld(dir);
-  ComposedScene composed = ComposeWorld(world.models, ComposeOptions{});
+  ComposedScene composed = ComposeMassless(world);
   // a compile here would throw MuJoCo's error
   EffectsStage stage(world, &composed);
   EXPECT_EQ(stage.agents().size(), 1u);
@@ -51,7 +61,7 @@ TEST(EffectsStageCompile, AgentsWithoutAPresetDoNotCompileTheModel) {
 TEST(EffectsStageCompile, APresetPlansOnACompiledProbe) {
   const penumbra::testing::TempDir dir;
   const WorldConfig world = MasslessWorld(dir);
-  ComposedScene composed = ComposeWorld(world.models, ComposeOptions{});
+  ComposedScene composed = ComposeMassless(world);
   try {
     EffectsStage stage(world, &composed, "minor");
     FAIL() << "expected MuJoCo's error from the planner's probe compile";

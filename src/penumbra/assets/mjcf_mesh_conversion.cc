@@ -1,12 +1,10 @@
 #include "penumbra/assets/mjcf_mesh_conversion.h"
 
 #include <fmt/format.h>
-#include <tinyxml2.h>
 
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
-#include <functional>
 
 #include "penumbra/assets/mesh_import.h"
 #include "penumbra/assets/mesh_model.h"
@@ -48,48 +46,24 @@ TriangleMesh Merge(const ImportedAsset& asset) {
   return out;
 }
 
-void Visit(tinyxml2::XMLElement* e, const std::function<void(tinyxml2::XMLElement*)>& fn) {
-  for (tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
-    fn(c);
-    Visit(c, fn);
-  }
-}
-
 }  // namespace
 
-std::vector<std::string> ConvertForeignMjcfMeshes(ComposedScene* composed, const std::string& dir) {
-  std::vector<std::string> converted;
+std::string ConvertForeignMjcfMesh(const std::string& file, const std::string& dir) {
+  const std::string ext = LowerMeshExtension(file);
+  if (ext == ".stl" || ext == ".obj" || ext == ".msh" || !IsMeshModelFile(file)) return "";
+  ImportedAsset asset;
+  try {
+    asset = ImportMeshFile(file, MeshImportConfig{});
+  } catch (const ConfigError& err) {
+    throw ConfigError(err.file(), err.line(), "mesh.file",
+                      "cannot convert mesh file " + err.file() + " for MuJoCo: " + err.problem());
+  }
   const fs::path folder =
       dir.empty() ? fs::temp_directory_path() / "penumbra-mesh-models" : fs::path(dir);
-  tinyxml2::XMLElement* root = composed->document->RootElement();
-  if (root == nullptr) return converted;
-  Visit(root, [&](tinyxml2::XMLElement* e) {
-    if (std::string(e->Name()) != "mesh") return;
-    const tinyxml2::XMLElement* parent = e->Parent() ? e->Parent()->ToElement() : nullptr;
-    if (parent == nullptr || std::string(parent->Name()) != "asset") return;
-    const char* file = e->Attribute("file");
-    if (file == nullptr) return;
-    const std::string ext = LowerMeshExtension(file);
-    if (ext == ".stl" || ext == ".obj" || ext == ".msh" || !IsMeshModelFile(file)) return;
-    ImportedAsset asset;
-    try {
-      asset = ImportMeshFile(file, MeshImportConfig{});
-    } catch (const ConfigError& err) {
-      const auto it = composed->sources.find(e);
-      const std::string where = it != composed->sources.end() ? it->second.file : "";
-      const int line = it != composed->sources.end() ? it->second.line : 0;
-      throw ConfigError(where, line, "mesh.file",
-                        "cannot convert mesh file " + err.file() + " for MuJoCo: " + err.problem());
-    }
-    const std::string bytes = MshBytes(Merge(asset));
-    std::error_code ec;
-    fs::create_directories(folder, ec);
-    const std::string out =
-        WriteContentNamedFile(folder, fs::path(file).stem().string(), ".msh", bytes);
-    converted.push_back(file);
-    e->SetAttribute("file", out.c_str());
-  });
-  return converted;
+  const std::string bytes = MshBytes(Merge(asset));
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  return WriteContentNamedFile(folder, fs::path(file).stem().string(), ".msh", bytes);
 }
 
 }  // namespace penumbra

@@ -75,10 +75,11 @@ CrowdSites ModelSources::crowd_sites(const std::vector<ModelConfig>& world_model
   return sites;
 }
 
-void ModelSources::ConvertComposedMeshes(ComposedScene* composed) const {
-  // MJCF <mesh> files MuJoCo 2.2.2 cannot read (glTF, FBX, COLLADA, PLY) become .msh files
-  for (const std::string& f : ConvertForeignMjcfMeshes(composed, mesh_dir_))
-    spdlog::info("converted MJCF mesh {} for MuJoCo", f);
+std::string ModelSources::ConvertMjcfMesh(const std::string& mesh_file) const {
+  // MJCF <mesh> files MuJoCo cannot read (glTF, FBX, COLLADA, PLY) become .msh files
+  std::string converted = ConvertForeignMjcfMesh(mesh_file, mesh_dir_);
+  if (!converted.empty()) spdlog::info("converted MJCF mesh {} for MuJoCo", mesh_file);
+  return converted;
 }
 
 void ModelSources::ApplyMaterials(const std::string& world_file, SceneDescription* scene) const {

@@ -4,8 +4,8 @@
 //   1. before composing: generated environments (`models:` entries with `environment:`,
 //      environment_model.h) become MJCF models and their lamps world lights; then mesh files
 //      (.obj, .gltf, ...) become generated MJCF models (assets/mesh_model.h);
-//   2. after composing: MJCF <mesh> files MuJoCo 2.2.2 cannot read become .msh files
-//      (assets/mjcf_mesh_conversion.h);
+//   2. while composing: MJCF <mesh> files MuJoCo cannot read become .msh files
+//      (assets/mjcf_mesh_conversion.h, through ComposeOptions::convert_mesh);
 //   3. on the scene extracted from the compiled model: the imported models' materials, then the
 //      procedural materials of the generated models and of the world file
 //      (assets/procedural_material.h).
@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "penumbra/assets/mesh_model.h"
-#include "penumbra/compose/scene_composer.h"
 #include "penumbra/effects/crowd_sim.h"
 #include "penumbra/environment/environment_model.h"
 #include "penumbra/scene/scene_description.h"
@@ -42,10 +41,10 @@ class ModelSources {
   /// pose of its model in `world_models` (where crowds go, session/effects_stage.h).
   CrowdSites crowd_sites(const std::vector<ModelConfig>& world_models) const;
 
-  /// step 2: rewrites the <mesh> files of `composed` that MuJoCo 2.2.2 cannot read to .msh
-  /// files in the mesh folder (ConvertForeignMjcfMeshes).
-  /// @throws ConfigError as ConvertForeignMjcfMeshes.
-  void ConvertComposedMeshes(ComposedScene* composed) const;
+  /// step 2: for a model's <mesh> file MuJoCo cannot read, the .msh file it is converted to in
+  /// the mesh folder (ConvertForeignMjcfMesh; logged); "" for a file MuJoCo reads.
+  /// @throws ConfigError as ConvertForeignMjcfMesh.
+  std::string ConvertMjcfMesh(const std::string& mesh_file) const;
 
   /// step 3: the imported models' materials (ApplyImportedMaterials), then the procedural
   /// materials of the generated models and of `world_file`'s `materials:`

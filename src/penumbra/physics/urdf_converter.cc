@@ -46,6 +46,29 @@ std::string WithImportOptions(const std::string& urdf) {
 
 }  // namespace
 
+std::string PrepareUrdfForMujoco(const std::string& urdf_path, const std::string& mesh_dir) {
+  const std::string text = ReadInputFile(urdf_path, "URDF file");
+  UrdfMeshConversion meshes = ConvertUrdfMeshes(urdf_path, text);
+  const std::filesystem::path dir =
+      mesh_dir.empty() ? std::filesystem::temp_directory_path() / "penumbra-urdf-meshes"
+                       : std::filesystem::path(mesh_dir);
+  std::string urdf = WithImportOptions(meshes.urdf);
+  for (const auto& [name, bytes] : meshes.files) {
+    const std::filesystem::path file = std::filesystem::absolute(dir / name);
+    std::error_code ec;
+    std::filesystem::create_directories(file.parent_path(), ec);
+    WriteFileAtomic(file, bytes);
+    for (const char q : {'"', '\''}) {
+      const std::string from = q + name + q;
+      const std::string to = q + file.string() + q;
+      for (size_t pos = urdf.find(from); pos != std::string::npos;
+           pos = urdf.find(from, pos + to.size()))
+        urdf.replace(pos, from.size(), to);
+    }
+  }
+  return urdf;
+}
+
 std::string ConvertUrdfToMjcfInto(const std::string& urdf_path, const std::string& mesh_dir) {
   const std::string text = ReadInputFile(urdf_path, "URDF file");
   // meshes MuJoCo cannot read become STL files: in memory for this load, on disk for the

@@ -13,7 +13,7 @@ namespace penumbra {
 /// (fusestatic="false"), so links named in world files still exist. mesh file names
 /// in the result are as MuJoCo stores them (path stripped) and resolve against the
 /// URDF's folder. a root link without a joint is welded to the world, as in MuJoCo.
-/// meshes MuJoCo 2.2.2 cannot read (DAE and the other formats assimp reads) are converted
+/// meshes MuJoCo cannot read (DAE and the other formats assimp reads) are converted
 /// to binary STL first (physics/urdf_meshes.h): each is written to `mesh_dir` (created if
 /// missing; empty: the folder "penumbra-urdf-meshes" in the system's temporary folder) and
 /// the result's <mesh file> names it by its absolute path. the files' names come from their
@@ -25,5 +25,14 @@ std::string ConvertUrdfToMjcfInto(const std::string& urdf_path, const std::strin
 
 /// ConvertUrdfToMjcfInto(urdf_path, ""): converted meshes go to the temporary folder.
 std::string ConvertUrdfToMjcf(const std::string& urdf_path);
+
+/// the URDF text at `urdf_path` ready for MuJoCo's own URDF parser (mj_parseXMLString; the
+/// composition step, physics/model_spec_composer.h): the import options above added unless
+/// the URDF has its own <mujoco> element, mesh files named by the paths where they were found
+/// (physics/urdf_meshes.h), and meshes MuJoCo cannot read converted to STL files in
+/// `mesh_dir` (as ConvertUrdfToMjcfInto) and named by their absolute paths.
+/// @throws ConfigError(urdf_path, mesh line, "", ...) as ConvertUrdfToMjcfInto; Error if a
+///         converted mesh cannot be written.
+std::string PrepareUrdfForMujoco(const std::string& urdf_path, const std::string& mesh_dir);
 
 }  // namespace penumbra

@@ -138,7 +138,7 @@ UrdfMeshConversion ConvertUrdfMeshes(const std::string& urdf_path, const std::st
         const XMLElement* geometry = e->FirstChildElement("geometry");
         const XMLElement* mesh = geometry ? geometry->FirstChildElement("mesh") : nullptr;
         const char* filename = mesh ? mesh->Attribute("filename") : nullptr;
-        if (filename == nullptr || MujocoReadsMeshFile(filename)) continue;
+        if (filename == nullptr) continue;
         if (std::find(done.begin(), done.end(), filename) != done.end()) continue;
         const std::string what = "link '" + link_name + "' " + part + " mesh '" + filename + "': ";
         fs::path found;
@@ -146,6 +146,12 @@ UrdfMeshConversion ConvertUrdfMeshes(const std::string& urdf_path, const std::st
         for (const fs::path& c : MeshCandidates(urdf_dir, filename)) {
           looked += (looked.empty() ? "" : ", ") + c.lexically_normal().string();
           if (found.empty() && fs::is_regular_file(c)) found = c.lexically_normal();
+        }
+        if (MujocoReadsMeshFile(filename)) {
+          // MuJoCo reads it: named by the path found (package:// and bare names resolved)
+          if (!found.empty()) ReplaceQuoted(&result.urdf, filename, found.string());
+          done.push_back(filename);
+          continue;
         }
         if (found.empty()) {
           throw ConfigError(urdf_path, mesh->GetLineNum(), "",
@@ -156,7 +162,7 @@ UrdfMeshConversion ConvertUrdfMeshes(const std::string& urdf_path, const std::st
           stl = MeshFileToStl(found.string());
         } catch (const Error& err) {
           throw ConfigError(urdf_path, mesh->GetLineNum(), "",
-                            what + "MuJoCo 2.2.2 reads only STL, OBJ and MSH and " + err.what());
+                            what + "MuJoCo reads only STL, OBJ and MSH and " + err.what());
         }
         char hash[17];
         std::snprintf(hash, sizeof(hash), "%016llx",

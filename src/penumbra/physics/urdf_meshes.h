@@ -1,7 +1,7 @@
 #pragma once
-// URDF meshes that MuJoCo 2.2.2 cannot read (COLLADA .dae and the other formats assimp
-// reads) converted into binary STL, which it can. ROS description packages mostly ship
-// DAE visuals; MuJoCo 2.2.2 reads only STL, OBJ and MSH.
+// URDF meshes that MuJoCo cannot read (COLLADA .dae and the other formats assimp reads)
+// converted into binary STL, which it can. ROS description packages mostly ship DAE visuals;
+// MuJoCo reads STL, OBJ and MSH.
 
 #include <string>
 #include <utility>
@@ -9,7 +9,7 @@
 
 namespace penumbra {
 
-/// true when MuJoCo 2.2.2 reads the mesh file itself: its extension is .stl, .obj or .msh
+/// true when MuJoCo reads the mesh file itself: its extension is .stl, .obj or .msh
 /// (any case). `filename` may carry a path or a package:// prefix.
 bool MujocoReadsMeshFile(const std::string& filename);
 
@@ -30,7 +30,8 @@ bool MujocoReadsMeshFile(const std::string& filename);
 std::string MeshFileToStl(const std::string& path);
 
 /// a URDF whose unreadable meshes were converted: `urdf` is the text with each such
-/// <mesh filename> replaced by the name of its STL, and `files` holds those STL files as
+/// <mesh filename> replaced by the name of its STL (and each readable one that was found by
+/// the path found), and `files` holds those STL files as
 /// (name, bytes). names are "<source stem>-<16 hex digits of the source's FNV-1a 64 hash>.stl",
 /// so the same mesh gets the same name and different meshes with one stem differ.
 struct UrdfMeshConversion {
@@ -39,12 +40,13 @@ struct UrdfMeshConversion {
 };
 
 /// finds every <link>/<visual|collision>/<geometry>/<mesh> of the URDF text `urdf_text`
-/// (read from `urdf_path`) whose file MuJoCo 2.2.2 cannot read and converts it with
-/// MeshFileToStl. a filename resolves like this, first existing wins: "file://" is dropped;
-/// "package://PKG/REST" looks for REST in the URDF's folder and in its parent (the usual
-/// PKG/urdf/robot.urdf + PKG/meshes layout); a relative path against the URDF's folder; an
-/// absolute path as is; finally the file's bare name in the URDF's folder (where MuJoCo's own
-/// URDF importer looks). text without such meshes is returned unchanged.
+/// (read from `urdf_path`) whose file MuJoCo cannot read and converts it with
+/// MeshFileToStl; a file MuJoCo reads is named by the path where it was found. a filename resolves
+/// like this, first existing wins: "file://" is dropped; "package://PKG/REST" looks for REST in the
+/// URDF's folder and in its parent (the usual PKG/urdf/robot.urdf + PKG/meshes layout); a relative
+/// path against the URDF's folder; an absolute path as is; finally the file's bare name in the
+/// URDF's folder (where MuJoCo's own URDF importer looks). text without such meshes is returned
+/// unchanged.
 /// @throws ConfigError(urdf_path, line of the <mesh>, "", ...) naming the link and the mesh
 ///         filename when the file is not found (listing the paths tried) or assimp fails.
 UrdfMeshConversion ConvertUrdfMeshes(const std::string& urdf_path, const std::string& urdf_text);

@@ -20,6 +20,7 @@
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/static_terrain_ray_caster.h"
+#include "penumbra/session/world_composer.h"
 #include "penumbra/world/run_budget.h"
 
 namespace penumbra {
@@ -225,8 +226,8 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   std::string mesh_dir;
   if (!options.composed_xml_path.empty())
     mesh_dir = (std::filesystem::path(options.composed_xml_path).parent_path() / "meshes").string();
-  compose_options.urdf_to_mjcf = [mesh_dir](const std::string& urdf_path) {
-    return ConvertUrdfToMjcfInto(urdf_path, mesh_dir);
+  compose_options.prepare_urdf = [mesh_dir](const std::string& urdf_path) {
+    return PrepareUrdfForMujoco(urdf_path, mesh_dir);
   };
   compose_options.timestep_sec = world_.timestep_sec;
   compose_options.physics = world_.physics;
@@ -241,9 +242,11 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
           : (std::filesystem::path(options.composed_xml_path).parent_path() / "environments")
                 .string(),
       mesh_dir);
+  compose_options.convert_mesh = [&sources](const std::string& file) {
+    return sources.ConvertMjcfMesh(file);
+  };
   ComposedScene composed = ComposeWorld(sources.models(), compose_options);
   poll("composing the models");
-  sources.ConvertComposedMeshes(&composed);
   AddImuSensors(world_.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
   effects_ =
       std::make_unique<EffectsStage>(world_, &composed, options.adversity,
@@ -259,29 +262,12 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   // physics (compiled once; a second, earlier compile only for an adversity preset's
   // planning, session/effects_stage.h), agent drivers and controllers
   t0 = Clock::now();
-  try {
-    sim_ = std::make_unique<Simulation>(
-        options.composed_xml_path.empty()
-            ? Simulation::LoadFromString(xml, world_.timestep_sec)
-            : Simulation::LoadFromFile(options.composed_xml_path, world_.timestep_sec));
-  } catch (const ConfigError& e) {
-    // MuJoCo names a line of the composed text: name the model file and line instead
-    // MuJoCo 2.2.2's collision detection takes nbody (nbody - 1) / 2 doubles of its stack
-    // (scene/scene_limits.h kMaxAgents): say so instead of only "Stack overflow"
-    if (e.problem().find("Stack overflow") != std::string::npos) {
-      size_t bodies = 1;  // the world body
-      for (size_t at = xml.find("<body"); at != std::string::npos; at = xml.find("<body", at + 5))
-        ++bodies;
-      throw ConfigError(
-          e.file(), e.line(), e.key(),
-          e.problem() + " (the composed model has " + std::to_string(bodies) +
-              " bodies, agents' included; MuJoCo 2.2.2's collision detection needs nbody (nbody - "
-              "1) / 2 doubles of its stack every step, and its automatic stack holds that up to "
-              "about 1,650 bodies; expected fewer bodies or agents, or a <size nstack=\"...\"/> in "
-              "a model)");
-    }
-    throw LocateComposedError(composed, e);
-  }
+  // every model compiled when it was composed (session/world_composer.h): an error now is in
+  // Penumbra's additions (IMU sites, agents), named by its line in the composed text
+  sim_ = std::make_unique<Simulation>(
+      options.composed_xml_path.empty()
+          ? Simulation::LoadFromString(xml, world_.timestep_sec)
+          : Simulation::LoadFromFile(options.composed_xml_path, world_.timestep_sec));
   // the world file's initial_keyframe of each model, before anything reads the state
   for (const ModelConfig& m : world_.models) {
     if (m.initial_keyframe.empty()) continue;

@@ -1,7 +1,7 @@
 #pragma once
 // a world loaded once: the one set-up sequence shared by `penumbra run`, the benchmarks, the
 // contact sheet and the tests. in order (each step's errors stop it; nothing is retried):
-//   1. compose   every model into one MJCF document (compose/scene_composer.h), the world's
+//   1. compose   every model into one MJCF document (session/world_composer.h), the world's
 //                IMUs added to it (compose/imu_injection.h), then the effects stage plans the
 //                world's effects, agents and adversity preset and adds one mocap body per agent
 //                (session/effects_stage.h), all on one tinyxml2 document, printed to text
