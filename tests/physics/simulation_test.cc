@@ -399,6 +399,24 @@ TEST(Simulation, KeyframeReachesUnnamedFreeJointsAndActuatorsOfItsModel) {
   EXPECT_EQ(s.act[0], 0.4) << "the activation of a/'s unnamed filter actuator";
 }
 
+TEST(Simulation, MultiInputActuatorsAreRefusedNamingTheActuator) {
+  // MuJoCo 4's <orientation> servo takes 3 controls and gives 3 forces
+  const char* xml = R"(
+<mujoco><worldbody>
+  <body><joint name="b" type="ball"/><geom size=".1"/></body>
+  <body pos="1 0 0"><joint name="h"/><geom size=".1"/></body>
+</worldbody>
+<actuator><motor joint="h"/><orientation name="wrist" joint="b" kp="10"/></actuator></mujoco>)";
+  try {
+    Simulation::LoadFromString(xml);
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "actuator wrist");
+    EXPECT_NE(std::string(e.what()).find("takes 3 controls and gives 3 forces"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Simulation, ControllersRunAtTheirRateOnSimTime) {
   Simulation sim = Simulation::LoadFromString(kArmXml, 0.003);
   auto c30 = std::make_unique<LambdaController>(30, std::vector<NameRequirement>{}, nullptr);

@@ -467,6 +467,20 @@ std::unique_ptr<Simulation::Impl> Simulation::LoadImpl(const std::string& loader
                       "the model's timestep is " + FormatG(m->opt.timestep) +
                           " s; expected seconds in [" + FormatG(kMinTimestepSec) + ", " +
                           FormatG(kMaxTimestepSec) + "]");
+  // MuJoCo 4's multi-input/output actuators (<orientation>, a pid with several inputs) take
+  // ctrlnum controls and give outnum forces; Penumbra's controllers, run logs, sensors and
+  // bridges address one control and one force per actuator
+  for (int a = 0; a < m->nactuator; ++a) {
+    if (m->actuator_ctrlnum[a] == 1 && m->actuator_outnum[a] == 1) continue;
+    const std::string name = NameOr(m, mjOBJ_ACTUATOR, a);
+    throw ConfigError(source, 0, "actuator " + (name.empty() ? "#" + std::to_string(a) : name),
+                      "the actuator takes " + std::to_string(m->actuator_ctrlnum[a]) +
+                          " controls and gives " + std::to_string(m->actuator_outnum[a]) +
+                          " forces (a MuJoCo 4 multi-input or multi-output actuator, e.g. "
+                          "<orientation>); Penumbra supports one control and one force per "
+                          "actuator: expected <motor>, <position>, <velocity>, <general> and the "
+                          "other single-input actuators");
+  }
   try {
     impl->d = mj_makeData(m);
     impl->snap_d = mj_makeData(m);
