@@ -116,6 +116,12 @@ void BatchStepper::Init(const std::string& mjcf_path, const std::string& xml) {
   try {
     config_.Validate(model_->nu);
     if (config_.actuation == BatchActuation::kJointPd) {
+      // MuJoCo 4 multi-input actuators (<orientation>) make nu, the controls, exceed the actuators
+      if (model_->nactuator != model_->nu)
+        throw ConfigError(mjcf_path, 0, "actuation",
+                          "joint_pd actuation needs one control per actuator; the model has " +
+                              std::to_string(model_->nactuator) + " actuators with " +
+                              std::to_string(model_->nu) + " controls");
       for (int a = 0; a < model_->nu; ++a) {
         const int joint = model_->actuator_trnid[2 * a];
         const bool joint_trn = model_->actuator_trntype[a] == mjTRN_JOINT;
