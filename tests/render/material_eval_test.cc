@@ -96,16 +96,31 @@ TEST(MaterialEvalTest, PlaneTexrepeatAndTexuniform) {
   s.materials[0].texuniform = true;
   s.materials[0].texrepeat = {4, 4};  // MuJoCo: texrepeat / 2 images per metre, 0.5 m per image
   {
+    // from the plane's corner (-2, 2) (texture_math.h): s = 2 (x + 2), t = 2 (2 - y);
+    // (0.375, -0.125): s = 4.75, t = 4.25 -> texel (1, 0) = white; one period (0.5 m) further
+    // in x and y the same.
     const MaterialEvaluator me(s);
-    // s = 2 x - 0.5, t = -2 y - 0.5 (MuJoCo's texture generation); (0.625, -0.375): s = 0.75,
-    // t = 0.25 -> texel (1, 0) = white; one period (0.5 m) further in x and y the same.
-    const Eigen::Vector3f a = me.Evaluate(HitAt({0.625f, -0.375f, 0}, {0, 0, 1})).pbr.base_color;
-    const Eigen::Vector3f b = me.Evaluate(HitAt({1.125f, 0.125f, 0}, {0, 0, 1})).pbr.base_color;
+    const Eigen::Vector3f a = me.Evaluate(HitAt({0.375f, -0.125f, 0}, {0, 0, 1})).pbr.base_color;
+    const Eigen::Vector3f b = me.Evaluate(HitAt({0.875f, 0.375f, 0}, {0, 0, 1})).pbr.base_color;
     EXPECT_NEAR((a - b).norm(), 0.0, 1e-6);
     EXPECT_NEAR(a.x(), 1.0, 1e-6);
     EXPECT_NEAR(a.z(), 1.0, 1e-6);
-    // (0.375, -0.375): s = t = 0.25 -> texel (0, 0) = black; (0.375, -0.125): s = 0.25, t = 0.75
-    // -> texel (0, 1) = red.
+    // (0.125, -0.125): s = 4.25, t = 4.25 -> texel (0, 0) = black; (0.125, -0.375): s = 4.25,
+    // t = 4.75 -> texel (0, 1) = red.
+    EXPECT_NEAR(me.Evaluate(HitAt({0.125f, -0.125f, 0}, {0, 0, 1})).pbr.base_color.norm(), 0.0,
+                1e-6);
+    const Eigen::Vector3f red = me.Evaluate(HitAt({0.125f, -0.375f, 0}, {0, 0, 1})).pbr.base_color;
+    EXPECT_NEAR(red.x(), 1.0, 1e-6);
+    EXPECT_NEAR(red.y(), 0.0, 1e-6);
+  }
+  s.geoms[0].size = {0, 0, 0};  // an infinite plane: MuJoCo's half-image offset instead
+  {
+    // s = 2 x - 0.5, t = -2 y - 0.5; (0.625, -0.375): s = 0.75, t = 0.25 -> white;
+    // (0.375, -0.375): s = t = 0.25 -> black; (0.375, -0.125): s = 0.25, t = 0.75 -> red.
+    const MaterialEvaluator me(s);
+    const Eigen::Vector3f a = me.Evaluate(HitAt({0.625f, -0.375f, 0}, {0, 0, 1})).pbr.base_color;
+    EXPECT_NEAR(a.x(), 1.0, 1e-6);
+    EXPECT_NEAR(a.z(), 1.0, 1e-6);
     EXPECT_NEAR(me.Evaluate(HitAt({0.375f, -0.375f, 0}, {0, 0, 1})).pbr.base_color.norm(), 0.0,
                 1e-6);
     const Eigen::Vector3f red = me.Evaluate(HitAt({0.375f, -0.125f, 0}, {0, 0, 1})).pbr.base_color;

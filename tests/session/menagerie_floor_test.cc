@@ -157,5 +157,53 @@ TEST(MenagerieFloor, TheCheckerKeepsItsContrast) {
   EXPECT_NEAR(matte.light / matte.dark, TextureContrast(), 0.05 * TextureContrast());
 }
 
+// a 2 x 1.6 m box (half sizes 1, 0.8, 0.05) with a light / dark checker at texrepeat 1.5 1.25,
+// per face and texuniform, seen from 2 m above: light or dark at 36 points of its top face as
+// MuJoCo 4.0.0 draws it (its own EGL render of this model): the checks counted from the face's
+// corner, not its centre (texture_math.h, PlanarMap).
+TEST(MenagerieFloor, CheckerOnABoxAsMujocoDrawsIt) {
+  const std::vector<double> xs = {-0.8, -0.5, -0.2, 0.1, 0.45, 0.8};
+  const std::vector<double> ys = {0.7, 0.45, 0.2, -0.1, -0.35, -0.6};
+  for (const auto& [material, expected] :
+       {std::pair<std::string, std::string>{"", "LLDDLLLLDDLLLLDDLLDDLLDDDDLLDDLLDDLL"},
+        std::pair<std::string, std::string>{R"(texuniform="true")",
+                                            "LLDDLLLLDDLLLLDDLLDDLLDDDDLLDDDDLLDD"}}) {
+    SCOPED_TRACE(material);
+    penumbra::testing::TempDir dir;
+    WorldConfig world = WorldForBareModel(dir.Write(
+        "box.xml",
+        R"(<mujoco><asset><texture type="2d" name="ck" builtin="checker" rgb1="0.9 0.9 0.9"
+           rgb2="0.1 0.1 0.1" width="64" height="64"/><material name="ck" texture="ck"
+           texrepeat="1.5 1.25" )" +
+            material +
+            R"(/></asset><worldbody><geom type="box" size="1 0.8 0.05" pos="0 0 0.05"
+           material="ck"/></worldbody></mujoco>)"));
+    world.cameras.clear();
+    SessionOptions options;
+    options.add_controllers = false;
+    Session session(world, options);
+    const CameraView view = DownView();
+    RenderedFrame frame;
+    session.renderer()->Render(session.sim().Snapshot(), nullptr, view, &frame);
+    const CameraIntrinsics& k = view.intrinsics;
+    const double depth = kHeightM - 0.1;  // to the box's top face
+    std::vector<double> l;
+    for (double y : ys)
+      for (double x : xs) {
+        const int u = static_cast<int>(std::lround(k.cx + x * k.fx / depth));
+        const int v = static_cast<int>(std::lround(k.cy - y * k.fy / depth));
+        double sum = 0;
+        for (int dv = -1; dv <= 1; ++dv)
+          for (int du = -1; du <= 1; ++du) sum += Luminance(frame.radiance.at(u + du, v + dv));
+        l.push_back(sum / 9);
+      }
+    const double mid =
+        0.5 * (*std::min_element(l.begin(), l.end()) + *std::max_element(l.begin(), l.end()));
+    std::string seen;
+    for (double x : l) seen += x > mid ? 'L' : 'D';
+    EXPECT_EQ(seen, expected);
+  }
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -314,7 +314,8 @@ MaterialEvaluator::Mapping2D MaterialEvaluator::MapAt(const SurfaceHit& hit,
       scene_.geoms[hit.geom].shape == GeomShape::kPlane && !(h[a0] > 0 && h[a1] > 0);
   if (m.texuniform || infinite_plane) {
     map.kind = Mapping2D::Kind::kUniform;
-    map.planar = PlanarMapUniform(hit.p_G[a0], hit.p_G[a1], m.texrepeat.x(), m.texrepeat.y());
+    map.planar = PlanarMapUniform(hit.p_G[a0], hit.p_G[a1], infinite_plane ? 0.0f : h[a0],
+                                  infinite_plane ? 0.0f : h[a1], m.texrepeat.x(), m.texrepeat.y());
   } else {
     map.kind = Mapping2D::Kind::kPerFace;
     const float h0 = h[a0] > 0 ? h[a0] : 1.0f, h1 = h[a1] > 0 ? h[a1] : 1.0f;

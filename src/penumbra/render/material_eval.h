@@ -9,11 +9,11 @@
 //    wrapped (repeat).
 //  - 2d texture elsewhere: planar projection of the hit point in the geom frame onto the
 //    plane of the dominant axis of the geom-frame normal (for planes and box faces: the face
-//    plane), by MuJoCo's OpenGL texture generation (texture_math.h, PlanarMap): with
-//    texuniform the texture repeats texrepeat / 2 times per metre (MuJoCo's unit-size geom is
-//    2 m across); without, texrepeat times across the geom's extent along that axis
-//    (2 x half-size; an infinite plane counts as uniform). s = 0.5 texrepeat.x x - 0.5 in those
-//    units, wrapped (repeat), image rows running along -y of the face.
+//    plane), as MuJoCo draws it (texture_math.h, PlanarMap): with texuniform the texture
+//    repeats texrepeat / 2 times per metre (MuJoCo's unit-size geom is 2 m across); without,
+//    texrepeat times across the geom's extent along that axis (2 x half-size; an infinite
+//    plane counts as uniform); counted from the face's corner (an infinite plane: from
+//    MuJoCo's half-image offset), wrapped (repeat), image rows running along -y of the face.
 //  - cube texture: looked up by the direction q = p_G / h (h = half extents of the geom's
 //    local bounding box; for a box each face shows a whole cube face, for a sphere q is the
 //    normal), with the face orientation of OpenGL cube maps (OpenGL 4.6 core spec, table 8.19)

@@ -237,11 +237,14 @@ PB_HOST_DEVICE inline float CubeRho(float w, float h_max) {
 /// a planar texture mapping at a point (render/material_eval.h, "texture mapping"): texture
 /// coordinates (s, t) in images, their derivatives ds / dp_a0 and dt / dp_a1 along the face
 /// axes a0, a1 (the only non-zero entries of the mapping's gradient), and its texels per metre.
-/// the formulas are MuJoCo's OpenGL texture generation for 2d textures (render_gl3.c,
-/// settexture: s = 0.5 scl_x x - 0.5, t = -0.5 scl_y y - 0.5 in the geom's unit-size object
-/// coordinates): per face, texrepeat images across the face (2 h); texuniform, texrepeat / 2
-/// images per metre (Menagerie's floor, texrepeat 5 with a 2 x 2 checker: 0.4 m per image,
-/// 0.2 m checks).
+/// the mapping is MuJoCo's for 2d textures (render_gl3.c, settexture: 0.5 texrepeat per unit
+/// of the geom's unit-size object coordinates), pinned down against MuJoCo 4.0.0's own renders
+/// of a quadrant texture on boxes and planes: on a face of half sizes (h0, h1) the coordinates
+/// run from its corner (-h0, +h1), s = 0.5 rx (p_a0 / h0 + 1), t = 0.5 ry (1 - p_a1 / h1); with
+/// texuniform the same without the division, s = 0.5 rx (p_a0 + h0), t = 0.5 ry (h1 - p_a1)
+/// (texrepeat / 2 images per metre); an infinite plane (no half sizes) has
+/// s = 0.5 rx p_a0 - 0.5, t = -0.5 ry p_a1 - 0.5. Menagerie's floor (an infinite plane,
+/// texrepeat 5, a 2 x 2 checker): 0.4 m per image, 0.2 m checks, edge marks at 0.2 m + k 0.4 m.
 struct PlanarMap {
   float s = 0, t = 0;
   float j0 = 0, j1 = 0;
@@ -256,28 +259,36 @@ struct PlanarMap {
   }
 };
 
-/// texuniform mapping: texrepeat (rx, ry) images per 2 m of the face coordinates p_a0, p_a1
-/// (MuJoCo's convention), image rows along -a1.
-PB_HOST_DEVICE inline PlanarMap PlanarMapUniform(float p_a0, float p_a1, float rx, float ry) {
+/// texuniform mapping: texrepeat (rx, ry) images per 2 m of the face coordinates p_a0, p_a1,
+/// counted from the face's corner (-h0, +h1) when it has half sizes h0, h1 > 0, else (an
+/// infinite plane, h0 or h1 <= 0) from MuJoCo's offset of half an image; image rows along -a1.
+PB_HOST_DEVICE inline PlanarMap PlanarMapUniform(float p_a0, float p_a1, float h0, float h1,
+                                                 float rx, float ry) {
   PlanarMap m;
   m.uniform = true;
   m.rx = rx, m.ry = ry;
-  m.s = 0.5f * rx * p_a0 - 0.5f;
-  m.t = -0.5f * ry * p_a1 - 0.5f;
+  if (h0 > 0 && h1 > 0) {
+    m.s = 0.5f * rx * (p_a0 + h0);
+    m.t = 0.5f * ry * (h1 - p_a1);
+  } else {
+    m.s = 0.5f * rx * p_a0 - 0.5f;
+    m.t = -0.5f * ry * p_a1 - 0.5f;
+  }
   m.j0 = 0.5f * rx;
   m.j1 = -0.5f * ry;
   return m;
 }
 
-/// per-face mapping: texrepeat times across the face of half sizes h0, h1 (> 0).
+/// per-face mapping: texrepeat times across the face of half sizes h0, h1 (> 0), from its
+/// corner (-h0, +h1).
 PB_HOST_DEVICE inline PlanarMap PlanarMapPerFace(float p_a0, float p_a1, float h0, float h1,
                                                  float rx, float ry) {
   PlanarMap m;
   m.uniform = false;
   m.rx = rx, m.ry = ry;
   m.h0 = h0, m.h1 = h1;
-  m.s = 0.5f * rx * p_a0 / h0 - 0.5f;
-  m.t = -0.5f * ry * p_a1 / h1 - 0.5f;
+  m.s = (0.5f * p_a0 / h0 + 0.5f) * rx;
+  m.t = (0.5f - 0.5f * p_a1 / h1) * ry;
   m.j0 = 0.5f * rx / h0;
   m.j1 = -0.5f * ry / h1;
   return m;

@@ -333,7 +333,8 @@ PB_HOST_DEVICE inline PlanarFootprint PlanarFootprintAt(const MaterialPod& m, co
   const int a0 = fp.a0, a1 = fp.a1;
   const bool infinite = g.plane != 0 && !(h[a0] > 0 && h[a1] > 0);
   if (m.texuniform != 0 || infinite)
-    fp.map = PlanarMapUniform(p[a0], p[a1], rx, ry);
+    fp.map = PlanarMapUniform(p[a0], p[a1], infinite ? 0.0f : h[a0], infinite ? 0.0f : h[a1], rx,
+                              ry);
   else
     fp.map =
         PlanarMapPerFace(p[a0], p[a1], h[a0] > 0 ? h[a0] : 1.0f, h[a1] > 0 ? h[a1] : 1.0f, rx, ry);
