@@ -195,6 +195,33 @@ TEST(WorldComposer, WorldOptionsOverrideTheModelsAndTimestepsAreChecked) {
   EXPECT_THROW(ComposeWorld({Model("z", zero)}, world_timestep), ConfigError);
 }
 
+TEST(WorldComposer, AMeshFormatMuJoCoCannotReadIsConvertedWhileComposing) {
+  penumbra::testing::TempDir dir;
+  dir.Write("tet.ply",
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 4\nproperty list uchar int vertex_indices\n"
+            "end_header\n0 0 0\n0.1 0 0\n0 0.1 0\n0 0 0.1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n"
+            "3 1 2 3\n");
+  const std::string model =
+      dir.Write("m.xml",
+                "<mujoco><asset><mesh name=\"tet\" file=\"tet.ply\"/></asset><worldbody><body "
+                "pos=\"0 0 0.5\"><freejoint/><geom type=\"mesh\" mesh=\"tet\"/></body></worldbody>"
+                "</mujoco>\n");
+  const std::filesystem::path out = dir.path() / "out";
+  std::filesystem::create_directories(out);
+  SessionOptions options = HeadlessComposed();
+  options.composed_xml_path = (out / "composed.xml").string();
+  Session session(WorldForBareModel(model), options);
+  // the .msh beside composed.xml, named there by its absolute path
+  int msh = 0;
+  for (const auto& f : std::filesystem::directory_iterator(out / "meshes"))
+    msh += f.path().extension() == ".msh" ? 1 : 0;
+  EXPECT_EQ(msh, 1);
+  const std::string xml = session.composed_xml();
+  EXPECT_NE(xml.find((out / "meshes").string()), std::string::npos);
+  EXPECT_EQ(session.sim().scene().meshes.size(), 1u);
+}
+
 // mjlab 1.6.0 vendors MuJoCo Menagerie's Unitree Go1, Unitree G1 and i2rt YAM (MJCF written for
 // MuJoCo 3, with meshes); scripts/install-deps.sh installs it into the project venv
 std::filesystem::path MjlabAssetZoo() {

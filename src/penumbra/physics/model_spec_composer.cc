@@ -307,7 +307,8 @@ void ModelSpecComposer::Attach(const SpecModel& model) {
       const std::string file = mjs_getString(mesh->file);
       if (file.empty()) continue;
       const std::string converted = model.convert_mesh(file);
-      if (!converted.empty()) mjs_setString(mesh->file, converted.c_str());
+      if (!converted.empty())
+        mjs_setString(mesh->file, std::filesystem::absolute(converted).string().c_str());
     }
   }
   if (model.floating_base) {
