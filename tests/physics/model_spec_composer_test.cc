@@ -279,6 +279,29 @@ TEST(ModelSpecComposer, WorldOptionsOverrideTheModels) {
   EXPECT_EQ(m->opt.gravity[2], -1.62);
 }
 
+TEST(ModelSpecComposer, KeysPlaceMocapBodiesByThePose) {
+  testing::TempDir dir;
+  const std::string file =
+      dir.Write("mocap.xml",
+                "<mujoco><worldbody><body name=\"target\" mocap=\"true\" pos=\"1 0 0\"><geom "
+                "size=\"0.05\" contype=\"0\" conaffinity=\"0\"/></body></worldbody><keyframe><key "
+                "name=\"k\" mpos=\"2 0 0.5\" mquat=\"1 0 0 0\"/></keyframe></mujoco>");
+  ModelSpecComposer c(kFloor, false);
+  c.Attach(Model("m", file, {0, 1, 0}, {std::cos(M_PI / 4), 0, 0, std::sin(M_PI / 4)}));
+  const ModelPtr m(c.Compile({}));
+  ASSERT_TRUE(m);
+  const int k = mj_name2id(m.get(), mjOBJ_KEY, "m/k");
+  ASSERT_GE(k, 0);
+  // (2, 0, 0.5) turned 90 degrees about z and moved by (0, 1, 0)
+  const double* p = m->key_mpos + 3 * k * m->nmocap;
+  EXPECT_NEAR(p[0], 0, 1e-12);
+  EXPECT_NEAR(p[1], 3, 1e-12);
+  EXPECT_NEAR(p[2], 0.5, 1e-12);
+  const double* q = m->key_mquat + 4 * k * m->nmocap;
+  EXPECT_NEAR(q[0], std::cos(M_PI / 4), 1e-12);
+  EXPECT_NEAR(q[3], std::sin(M_PI / 4), 1e-12);
+}
+
 // mjlab 1.6.0 vendors MuJoCo Menagerie's Unitree Go1, Unitree G1 and i2rt YAM (MJCF for
 // MuJoCo 3, with meshes); scripts/install-deps.sh installs it into the project venv
 std::filesystem::path AssetZoo() {
