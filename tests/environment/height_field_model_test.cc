@@ -200,9 +200,13 @@ TEST(HeightField, AMeshModelWithCollisionHeightfieldCollidesAsItsSampledField) {
   EXPECT_LT(worst, 1e-3);
   // the mesh does not collide any more; the field does (MuJoCo's defaults)
   const std::string& xml = session.composed_xml();
-  EXPECT_NE(xml.find("type=\"mesh\""), std::string::npos);
-  EXPECT_EQ(xml.find("type=\"mesh\" mesh=\"ground/"), xml.find("type=\"mesh\""));
-  EXPECT_NE(xml.find("contype=\"0\" conaffinity=\"0\""), std::string::npos);
+  const size_t mesh_at = xml.find("type=\"mesh\"");
+  ASSERT_NE(mesh_at, std::string::npos);
+  const size_t line_start = xml.rfind('\n', mesh_at) + 1;
+  const std::string line = xml.substr(line_start, xml.find('\n', mesh_at) - line_start);
+  EXPECT_NE(line.find("mesh=\"ground/"), std::string::npos) << line;
+  EXPECT_NE(line.find("contype=\"0\""), std::string::npos) << line;
+  EXPECT_NE(line.find("conaffinity=\"0\""), std::string::npos) << line;
 
   // heightfield_cell_m needs collision: heightfield
   const std::string bad = dir.Write(

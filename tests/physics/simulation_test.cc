@@ -13,6 +13,7 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/core/error.h"
+#include "penumbra/physics/mujoco_runtime.h"
 
 namespace penumbra {
 namespace {
@@ -415,6 +416,24 @@ TEST(Simulation, MultiInputActuatorsAreRefusedNamingTheActuator) {
     EXPECT_NE(std::string(e.what()).find("takes 3 controls and gives 3 forces"), std::string::npos)
         << e.what();
   }
+}
+
+TEST(Simulation, MujocosOwnPluginsLoad) {
+  // MuJoCo's PID actuator plugin, from the plugin folder the wheel ships beside libmujoco
+  ASSERT_FALSE(MujocoPluginDir().empty()) << "the mujoco wheel ships mujoco/plugin/";
+  const char* xml = R"(
+<mujoco><option gravity="0 0 0"/>
+  <extension><plugin plugin="mujoco.pid"><instance name="pid1">
+    <config key="kp" value="40"/><config key="ki" value="4"/><config key="kd" value="4"/>
+  </instance></plugin></extension>
+  <worldbody><body><joint name="j" type="hinge"/>
+    <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/></body></worldbody>
+  <actuator><plugin name="servo" joint="j" plugin="mujoco.pid" instance="pid1" actdim="1"/>
+  </actuator></mujoco>)";
+  Simulation sim = Simulation::LoadFromString(xml);
+  sim.ctrl()[0] = 0.5;
+  for (int i = 0; i < 2000; ++i) sim.Step();
+  EXPECT_NEAR(sim.GetState().qpos[0], 0.5, 0.01) << "the PID holds the joint at its setpoint";
 }
 
 TEST(Simulation, ControllersRunAtTheirRateOnSimTime) {

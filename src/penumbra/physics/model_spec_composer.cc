@@ -154,7 +154,11 @@ void Store(const Eigen::Quaterniond& q, double* out) {
 // the body frame.
 void PlaceKeys(mjSpec* s, const mjModel* m, const Eigen::Vector3d& p_WM,
                const Eigen::Quaterniond& q_WM) {
-  for (mjsElement* e = mjs_firstElement(s, mjOBJ_KEY); e; e = mjs_nextElement(s, e)) {
+  int index = 0;
+  for (mjsElement* e = mjs_firstElement(s, mjOBJ_KEY); e; e = mjs_nextElement(s, e), ++index) {
+    // an unnamed key (e.g. from <size nkey="5">) would become "M/" for each: name it by its
+    // index, "M/key<i>"
+    if (mjs_getName(e)->empty()) mjs_setName(e, ("key" + std::to_string(index)).c_str());
     mjsKey* k = mjs_asKey(e);
     std::vector<double> qpos = Doubles(k->qpos), qvel = Doubles(k->qvel);
     std::vector<double> mpos = Doubles(k->mpos), mquat = Doubles(k->mquat);

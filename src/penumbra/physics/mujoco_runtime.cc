@@ -1,5 +1,6 @@
 #include "penumbra/physics/mujoco_runtime.h"
 
+#include <dlfcn.h>
 #include <malloc.h>
 
 #include <cstring>
@@ -45,11 +46,23 @@ std::string OneLine(std::string s) {
 
 }  // namespace
 
+std::string MujocoPluginDir() {
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<const void*>(&mj_version), &info) == 0 || !info.dli_fname) return "";
+  const std::filesystem::path dir = std::filesystem::path(info.dli_fname).parent_path() / "plugin";
+  std::error_code ec;
+  return std::filesystem::is_directory(dir, ec) ? dir.string() : std::string();
+}
+
 void InstallMujocoHandlers() {
   static std::once_flag once;
   std::call_once(once, [] {
     mju_user_error = ThrowingErrorHandler;
     mju_user_warning = CapturingWarningHandler;
+    // MuJoCo's own plugins (mujoco.pid, mujoco.sensor.touch_grid, mujoco.sdf.*, ...), which
+    // the wheel ships beside libmujoco, as MuJoCo's simulate loads them
+    const std::string dir = MujocoPluginDir();
+    if (!dir.empty()) mj_loadAllPluginLibraries(dir.c_str(), nullptr);
   });
 }
 

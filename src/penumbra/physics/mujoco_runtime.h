@@ -25,8 +25,13 @@ class MujocoError : public PhysicsError {
   explicit MujocoError(const std::string& what) : PhysicsError(what) {}
 };
 
-/// installs penumbra's MuJoCo error/warning handlers (once; thread-safe, idempotent).
+/// installs penumbra's MuJoCo error/warning handlers and loads MuJoCo's own plugin libraries
+/// (MujocoPluginDir) so that models using them load (once; thread-safe, idempotent).
 void InstallMujocoHandlers();
+
+/// the folder of MuJoCo's first-party plugin libraries shipped with the linked libmujoco (the
+/// wheel's `mujoco/plugin/`: actuator, sensor and SDF plugins); "" when there is none.
+std::string MujocoPluginDir();
 
 /// sets the calling thread's sink for MuJoCo warning texts (nullptr = drop them).
 /// returns the previous sink.
