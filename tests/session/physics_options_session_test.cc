@@ -39,5 +39,39 @@ TEST(PhysicsOptionsSession, ImplicitfastFromTheWorldFileIsTheComposedModelsInteg
   EXPECT_NEAR(sim.Snapshot().X_WB.back().translation().z(), 0.1, 0.01);
 }
 
+TEST(PhysicsOptionsSession, NoslipAndSpeculativeContactsFromTheWorldFileReachComposedXml) {
+  penumbra::testing::TempDir dir;
+  dir.Write("box.xml",
+            "<mujoco><worldbody><geom type=\"plane\" size=\"2 2 0.1\"/>"
+            "<body pos=\"0 0 0.5\"><freejoint/><geom type=\"box\" size=\"0.1 0.1 0.1\"/></body>"
+            "</worldbody></mujoco>\n");
+  const std::string world = dir.Write("world.yaml",
+                                      "physics: {noslip_iterations: 10, speculative: true}\n"
+                                      "models:\n"
+                                      "  - name: box\n"
+                                      "    file: box.xml\n");
+  SessionOptions options;
+  options.build_renderer = false;
+  options.composed_xml_path = dir.str() + "/composed.xml";
+  Session session(LoadWorldFile(world), options);
+  std::ifstream in(options.composed_xml_path);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("noslip_iterations=\"10\""), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("speculative=\"enable\""), std::string::npos) << text.str();
+  // out of range: the key and the range
+  const std::string bad = dir.Write("bad.yaml",
+                                    "physics: {noslip_iterations: 5000}\n"
+                                    "models:\n"
+                                    "  - {name: box, file: box.xml}\n");
+  try {
+    LoadWorldFile(bad);
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("physics.noslip_iterations"), std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -424,6 +424,7 @@ mjModel* ModelSpecComposer::Compile(const SpecOptionOverrides& overrides) {
   }
   if (overrides.solver_iterations) opt.iterations = *overrides.solver_iterations;
   if (overrides.cone) opt.cone = *overrides.cone == "elliptic" ? mjCONE_ELLIPTIC : mjCONE_PYRAMIDAL;
+  ApplyContactOptions(overrides.contact, &opt);
 
   std::vector<std::string> mj_warnings;
   std::lock_guard<std::mutex> lock(MujocoLoaderMutex());

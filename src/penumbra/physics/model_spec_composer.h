@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/physics/physics_options.h"
+
 struct mjSpec_;
 struct mjModel_;
 
@@ -69,6 +71,7 @@ struct SpecOptionOverrides {
   std::optional<std::array<double, 3>> gravity_mps2;
   std::optional<int> solver_iterations;
   std::optional<std::string> cone;  ///< pyramidal or elliptic
+  ContactOptions contact;           ///< NoSlip iterations, speculative contacts
 };
 
 /// builds one world spec from Penumbra's own MJCF and model files.

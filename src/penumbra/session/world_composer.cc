@@ -71,6 +71,8 @@ ComposedScene ComposeWorld(const std::vector<ModelConfig>& models, const Compose
         std::array<double, 3>{p.gravity_mps2->x(), p.gravity_mps2->y(), p.gravity_mps2->z()};
   overrides.solver_iterations = p.solver_iterations;
   overrides.cone = p.cone;
+  overrides.contact.noslip_iterations = p.noslip_iterations;
+  overrides.contact.speculative = p.speculative;
   const std::string xml = composer.SaveXml(overrides);
   return MakeComposedScene(xml, models, composer.warnings(), options);
 }

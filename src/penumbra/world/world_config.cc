@@ -70,6 +70,9 @@ class WorldParser {
         w.physics.solver_iterations = found->Int();
       if (const auto found = p.Find("cone"))
         w.physics.cone = found->Enum({"pyramidal", "elliptic"});
+      if (const auto found = p.Find("noslip_iterations"))
+        w.physics.noslip_iterations = found->Int();
+      if (const auto found = p.Find("speculative")) w.physics.speculative = found->Bool();
       p.ReportUnused();
     }
     if (const auto found = r.Find("render")) ReadRender(*found, &w.render);

@@ -79,8 +79,17 @@ struct PhysicsOptions {
   std::optional<int> solver_iterations;
   /// <option cone>: the friction cone, "pyramidal" or "elliptic".
   std::optional<std::string> cone;
+  /// <option noslip_iterations>: iterations of MuJoCo's NoSlip post-solver, in [0, 1000];
+  /// 0 = off (physics/physics_options.h).
+  std::optional<int> noslip_iterations;
+  /// <option><flag speculative>: MuJoCo 4's speculative contacts (fast convex geoms do not
+  /// tunnel through thin obstacles).
+  std::optional<bool> speculative;
 
-  bool empty() const { return !integrator && !gravity_mps2 && !solver_iterations && !cone; }
+  bool empty() const {
+    return !integrator && !gravity_mps2 && !solver_iterations && !cone && !noslip_iterations &&
+           !speculative;
+  }
 };
 
 /// a world-file light (see scene Light for units).

@@ -73,6 +73,9 @@ class Validator {
       Check3("physics.gravity_mps2", *w_.physics.gravity_mps2, Range::Closed(-1000, 1000));
     if (w_.physics.solver_iterations)
       Check("physics.solver_iterations", *w_.physics.solver_iterations, Range::Closed(1, 10000));
+    // physics/physics_options.h kMaxNoslipIterations
+    if (w_.physics.noslip_iterations)
+      Check("physics.noslip_iterations", *w_.physics.noslip_iterations, Range::Closed(0, 1000));
     if (w_.physics.integrator && *w_.physics.integrator != "Euler" &&
         *w_.physics.integrator != "RK4" && *w_.physics.integrator != "implicit" &&
         *w_.physics.integrator != "implicitfast")
