@@ -285,11 +285,7 @@ void ModelSpecComposer::Attach(const SpecModel& model) {
   models_.push_back(model);
   std::vector<std::string> mj_warnings;
   std::lock_guard<std::mutex> lock(MujocoLoaderMutex());
-  std::vector<std::string>* previous_sink = SetMujocoWarningSink(&mj_warnings);
-  struct RestoreSink {
-    std::vector<std::string>* previous;
-    ~RestoreSink() { SetMujocoWarningSink(previous); }
-  } restore{previous_sink};
+  const ScopedMujocoWarningSink sink(&mj_warnings);
 
   char error[1024] = "";
   SpecPtr child(model.text.empty()
@@ -428,11 +424,7 @@ mjModel* ModelSpecComposer::Compile(const SpecOptionOverrides& overrides) {
 
   std::vector<std::string> mj_warnings;
   std::lock_guard<std::mutex> lock(MujocoLoaderMutex());
-  std::vector<std::string>* previous_sink = SetMujocoWarningSink(&mj_warnings);
-  struct RestoreSink {
-    std::vector<std::string>* previous;
-    ~RestoreSink() { SetMujocoWarningSink(previous); }
-  } restore{previous_sink};
+  const ScopedMujocoWarningSink sink(&mj_warnings);
   ModelPtr compiled(mj_compile(world_, nullptr));
   if (!compiled) {
     const std::string msg = Trimmed(mjs_getError(world_));

@@ -37,6 +37,19 @@ std::string MujocoPluginDir();
 /// returns the previous sink.
 std::vector<std::string>* SetMujocoWarningSink(std::vector<std::string>* sink);
 
+/// sets the calling thread's warning sink for its lifetime and restores the previous one.
+class ScopedMujocoWarningSink {
+ public:
+  explicit ScopedMujocoWarningSink(std::vector<std::string>* sink)
+      : previous_(SetMujocoWarningSink(sink)) {}
+  ~ScopedMujocoWarningSink() { SetMujocoWarningSink(previous_); }
+  ScopedMujocoWarningSink(const ScopedMujocoWarningSink&) = delete;
+  ScopedMujocoWarningSink& operator=(const ScopedMujocoWarningSink&) = delete;
+
+ private:
+  std::vector<std::string>* previous_;
+};
+
 /// serialises MuJoCo's XML loader and mj_saveLastXML.
 std::mutex& MujocoLoaderMutex();
 
