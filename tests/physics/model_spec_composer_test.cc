@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "common/modern_mjcf.h"
 #include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 
@@ -20,36 +21,7 @@ constexpr const char* kFloor =
     "<mujoco><worldbody><geom name=\"floor\" type=\"plane\" size=\"0 0 1\"/></worldbody>"
     "</mujoco>";
 
-// MuJoCo 3 features that MuJoCo 2.2.2 lacked: <frame> with children, <replicate>, a mesh
-// named only in a default class (the Allegro case), degrees and euler, an unnamed
-// <freejoint/> with a keyframe that starts the body lower than its pos (the Go2 case)
-constexpr const char* kModern = R"(<mujoco model="modern">
-  <compiler angle="degree" autolimits="true"/>
-  <default>
-    <default class="shell"><geom type="mesh" mesh="tetra" rgba="0.5 0.5 0.5 1"/></default>
-  </default>
-  <asset>
-    <mesh name="tetra" vertex="0 0 0  0.1 0 0  0 0.1 0  0 0 0.1"/>
-  </asset>
-  <worldbody>
-    <body name="base" pos="0 0 0.445">
-      <freejoint/>
-      <geom name="torso" type="box" size="0.1 0.05 0.03"/>
-      <frame pos="0.1 0 0" euler="0 0 90">
-        <body name="arm">
-          <joint name="hinge" range="-90 90"/>
-          <geom name="shell" class="shell"/>
-        </body>
-      </frame>
-      <replicate count="4" offset="0 0.02 0">
-        <geom name="stud" type="sphere" size="0.01" pos="-0.1 0 -0.03"/>
-      </replicate>
-    </body>
-  </worldbody>
-  <actuator><position name="hinge" joint="hinge" kp="5"/></actuator>
-  <keyframe><key name="stand" qpos="0 0 0.27 1 0 0 0 0.5" ctrl="0.5"/></keyframe>
-</mujoco>
-)";
+using testing::kModernMjcf;
 
 struct ModelDeleter {
   void operator()(mjModel* m) const { mj_deleteModel(m); }
@@ -89,7 +61,7 @@ std::vector<double> Trajectory(const mjModel* m, int steps, int key = -1) {
 
 TEST(ModelSpecComposer, ModernMjcfComposesAtItsPose) {
   testing::TempDir dir;
-  const std::string file = dir.Write("modern.xml", kModern);
+  const std::string file = dir.Write("modern.xml", kModernMjcf);
   ModelSpecComposer c(kFloor, false);
   c.Attach(Model("a", file, {1, 2, 0}, {std::cos(M_PI / 4), 0, 0, std::sin(M_PI / 4)}));
   c.Attach(Model("b", file, {-1, 0, 0}));
@@ -130,7 +102,7 @@ TEST(ModelSpecComposer, ModernMjcfComposesAtItsPose) {
 
 TEST(ModelSpecComposer, SavedXmlCompilesToTheSamePhysics) {
   testing::TempDir dir;
-  const std::string file = dir.Write("modern.xml", kModern);
+  const std::string file = dir.Write("modern.xml", kModernMjcf);
   // an asset file relative to its model's folder, with a compiler meshdir
   dir.Write("sub/assets/box.obj",
             "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
