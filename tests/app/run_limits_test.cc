@@ -90,7 +90,7 @@ TEST_F(RunLimitsTest, AnAgentCountBeyondTheLimitIsRefusedBeforeAnythingIsSetUp) 
 }
 
 TEST_F(RunLimitsTest, AsManyAgentsAsTheLimitAllowsRun) {
-  // the limit is what MuJoCo 2.2.2 can collide: at the limit the run completes
+  // the limit keeps MuJoCo's collision arena small: at the limit the run completes
   const std::string world = tmp_.Write("limit.yaml", WorldText(0, 16, 16, kMaxAgents));
   const auto [code, seconds] = Run(world);
   EXPECT_EQ(code, 0) << err_;

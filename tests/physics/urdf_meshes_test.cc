@@ -1,4 +1,4 @@
-// URDF meshes MuJoCo 2.2.2 cannot read (COLLADA) converted to STL through assimp.
+// URDF meshes MuJoCo cannot read (COLLADA) converted to STL through assimp.
 
 #include "penumbra/physics/urdf_meshes.h"
 

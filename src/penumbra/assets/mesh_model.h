@@ -42,7 +42,7 @@ struct ImportedModel {
   double hull_volume_ratio = 0;
 };
 
-/// MuJoCo 2.2.2's binary .msh bytes of `mesh` (4 int32 counts nvertex, nnormal, ntexcoord,
+/// MuJoCo's legacy binary .msh bytes of `mesh` (4 int32 counts nvertex, nnormal, ntexcoord,
 /// nface, then float32 positions, normals, texcoords and int32 faces, little-endian). meshes
 /// with fewer than 4 vertices get copies of their first vertex (MuJoCo's minimum); a flat mesh
 /// (all vertices within 1e-6 of its extent from one plane) gets one vertex no face uses,

@@ -6,7 +6,7 @@
 // kinematic (MuJoCo mocap: no joints, posed through mocap_pos / mocap_quat by physics
 // Simulation::AddMocapDriver; session/agent_drivers.h drives the root from the agent's path and
 // each part from the root and its joint angles), so robots and free bodies collide with them
-// and are pushed, while agents never react to contact. MuJoCo 2.2.2 allows mocap bodies only as
+// and are pushed, while agents never react to contact. MuJoCo allows mocap bodies only as
 // children of the world, so the articulation is computed (effects/walker_gait.h forward
 // kinematics), not a MuJoCo joint tree: hinge joints would make the limbs dynamic (pushed by
 // the robot, changing nq / nv). MuJoCo filters contacts between bodies welded to the world, so

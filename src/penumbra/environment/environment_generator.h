@@ -43,7 +43,7 @@ struct GeneratedFile {
 
 /// everything one generated environment consists of.
 struct GeneratedEnvironment {
-  std::string mjcf;  ///< the model (MJCF 2.2.2 text, static geoms of the world body)
+  std::string mjcf;                  ///< the model (MJCF text, static geoms of the world body)
   std::vector<GeneratedFile> files;  ///< files `mjcf` refers to by placeholder
   /// `procedural:` materials of the model's MJCF materials; `material` is the model-local name
   /// (the session prefixes "<model>/"), `line` 0.

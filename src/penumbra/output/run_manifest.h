@@ -42,7 +42,7 @@ struct RunManifest {
   std::string world_file;  ///< path of the world file or bare model
   uint64_t seed = 0;
   std::string penumbra_version;           ///< e.g. "0.1.0"
-  std::string mujoco_version;             ///< e.g. "2.2.2" (mj_versionString)
+  std::string mujoco_version;             ///< e.g. "4.0.0" (mj_versionString)
   std::string embree_version;             ///< e.g. "3.13.5"
   std::vector<std::string> command_line;  ///< argv, one entry per argument
   double sim_duration_sec = 0;  ///< sim time reached: time of the last completed physics step

@@ -4,7 +4,7 @@
 
 namespace penumbra {
 
-/// the linked MuJoCo library's version string (mj_versionString), e.g. "2.2.2".
+/// the linked MuJoCo library's version string (mj_versionString), e.g. "4.0.0".
 std::string MujocoVersion();
 
 }  // namespace penumbra

@@ -1,7 +1,7 @@
 #pragma once
 // a height field sampled from static geometry by casting rays straight down (docs/environments.md
 // "Height fields"): for robust, fast robot-terrain contact, a terrain mesh's collision becomes a
-// MuJoCo hfield (MuJoCo 2.2.2 XML reference, <hfield>) of the heights the rays hit.
+// MuJoCo hfield (MuJoCo XML reference, <hfield>) of the heights the rays hit.
 //
 // sampling: the grid has `cols` x `rows` samples spaced cell_m apart, sample (r, c) at
 // (x0 + c cell_m, y0 + r cell_m); each is the height of the first surface a ray from z_top

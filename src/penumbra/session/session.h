@@ -44,7 +44,7 @@ struct SessionOptions {
   std::string adversity;
   /// where to keep the composed MJCF (e.g. "<output_dir>/composed.xml"); MuJoCo then loads
   /// that file, so its messages (and PhysicsError's) name it. "" = loaded from memory
-  /// (messages name "<string>"), nothing written. URDF meshes MuJoCo 2.2.2 cannot read
+  /// (messages name "<string>"), nothing written. URDF meshes MuJoCo cannot read
   /// (DAE, ...) are converted to STL files in "meshes/" beside it ("" = in the temporary
   /// folder's "penumbra-urdf-meshes"; physics/urdf_converter.h).
   std::string composed_xml_path;
