@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "common/mjlab_assets.h"
 #include "penumbra/config/yaml_document.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/physics/simulation.h"
@@ -21,12 +22,10 @@ namespace penumbra {
 namespace {
 
 const std::string kWrappers = PENUMBRA_SOURCE_DIR "/worlds/models/menagerie";
-// the path the wrappers' <model file=...> names (relative to kWrappers)
-const std::string kMjlabRobots =
-    PENUMBRA_SOURCE_DIR "/.venv/lib/python3.11/site-packages/mjlab/asset_zoo/robots";
+const std::string kMjlabRobots = testing::MjlabRobotsDir();
 
 bool MjlabRobotInstalled(const std::string& robot_xml) {
-  return std::filesystem::exists(kMjlabRobots + "/" + robot_xml);
+  return !kMjlabRobots.empty() && std::filesystem::exists(kMjlabRobots + "/" + robot_xml);
 }
 
 // the wrapper `file` with a floor added to its world body, loaded with its keyframe "home".

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "common/mjlab_assets.h"
 #include "common/modern_mjcf.h"
 #include "common/temp_dir.h"
 #include "penumbra/core/error.h"
@@ -274,20 +275,8 @@ TEST(ModelSpecComposer, KeysPlaceMocapBodiesByThePose) {
   EXPECT_NEAR(q[3], std::sin(M_PI / 4), 1e-12);
 }
 
-// mjlab 1.6.0 vendors MuJoCo Menagerie's Unitree Go1, Unitree G1 and i2rt YAM (MJCF for
-// MuJoCo 3, with meshes); scripts/install-deps.sh installs it into the project venv
-std::filesystem::path AssetZoo() {
-  const std::filesystem::path lib = std::filesystem::path(PENUMBRA_SOURCE_DIR) / ".venv/lib";
-  std::error_code ec;
-  for (const auto& e : std::filesystem::directory_iterator(lib, ec)) {
-    const auto zoo = e.path() / "site-packages/mjlab/asset_zoo/robots";
-    if (std::filesystem::is_directory(zoo)) return zoo;
-  }
-  return {};
-}
-
 TEST(ModelSpecComposer, MenagerieModelsComposeUnmodified) {
-  const std::filesystem::path zoo = AssetZoo();
+  const std::filesystem::path zoo = testing::MjlabRobotsDir();
   if (zoo.empty()) GTEST_SKIP() << "mjlab (pip mjlab==1.6.0) is not in the project venv";
   ModelSpecComposer c(kFloor, false);
   c.Attach(Model("go1", (zoo / "unitree_go1/xmls/go1.xml").string(), {0, 0, 0.45}));

@@ -8,14 +8,14 @@
 #include <filesystem>
 #include <string>
 
+#include "common/mjlab_assets.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
 namespace {
 
-const std::string kMjlabWorldRobots =
-    PENUMBRA_SOURCE_DIR "/.venv/lib/python3.11/site-packages/mjlab/asset_zoo/robots";
+const std::string kMjlabWorldRobots = testing::MjlabRobotsDir();
 
 // runs worlds/<name>.yaml for `seconds` without a renderer; the pose of `body` at the end
 Pose RunMenagerieWorld(const std::string& name, const std::string& body, double seconds,

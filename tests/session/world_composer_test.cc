@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <string>
 
+#include "common/mjlab_assets.h"
 #include "common/model_config.h"
 #include "common/modern_mjcf.h"
 #include "common/temp_dir.h"
@@ -194,20 +195,8 @@ TEST(WorldComposer, AMeshFormatMuJoCoCannotReadIsConvertedWhileComposing) {
   EXPECT_EQ(session.sim().scene().meshes.size(), 1u);
 }
 
-// mjlab 1.6.0 vendors MuJoCo Menagerie's Unitree Go1, Unitree G1 and i2rt YAM (MJCF written for
-// MuJoCo 3, with meshes); scripts/install-deps.sh installs it into the project venv
-std::filesystem::path MjlabAssetZoo() {
-  const std::filesystem::path lib = std::filesystem::path(PENUMBRA_SOURCE_DIR) / ".venv/lib";
-  std::error_code ec;
-  for (const auto& e : std::filesystem::directory_iterator(lib, ec)) {
-    const auto zoo = e.path() / "site-packages/mjlab/asset_zoo/robots";
-    if (std::filesystem::is_directory(zoo)) return zoo;
-  }
-  return {};
-}
-
 TEST(WorldComposer, MenagerieModelsRunUnmodifiedNextToAFloor) {
-  const std::filesystem::path zoo = MjlabAssetZoo();
+  const std::filesystem::path zoo = testing::MjlabRobotsDir();
   if (zoo.empty()) GTEST_SKIP() << "mjlab (pip mjlab==1.6.0) is not in the project venv";
   for (const char* rel :
        {"unitree_go1/xmls/go1.xml", "unitree_g1/xmls/g1.xml", "i2rt_yam/xmls/yam.xml"}) {
