@@ -102,7 +102,7 @@ void FallSink::OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot) 
       spdlog::warn(
           "robot '{}' stumbled from its initial pose in its first {:g} s: its base {} dropped "
           "{:.3f} m and tilted {:.1f} deg{}",
-          targets_[i].robot, StartRule{}.window_sec, targets_[i].body, start.max_drop_m(),
+          targets_[i].robot, start.rule().window_sec, targets_[i].body, start.max_drop_m(),
           start.max_tilt_change_deg(),
           targets_[i].has_initial_keyframe
               ? " (from the world file's initial_keyframe: is it a standing pose its "

@@ -98,6 +98,7 @@ class StartCheck {
   double max_drop_m() const { return max_drop_m_; }                ///< within the window, m
   double max_tilt_change_deg() const { return max_tilt_change_; }  ///< within the window
   bool stumbled() const { return stumbled_; }  ///< decided once the window has passed
+  const StartRule& rule() const { return rule_; }
 
  private:
   StartRule rule_;
