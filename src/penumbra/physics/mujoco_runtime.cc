@@ -103,17 +103,17 @@ mjModel* LoadMujocoXmlLocked(const std::string& path, const std::string* content
   }
   char error[2048] = "";
   std::vector<std::string> loader_warnings;
-  std::vector<std::string>* old_sink = SetMujocoWarningSink(&loader_warnings);
   mjModel* m = nullptr;
-  try {
-    m = mj_loadXML(path.c_str(), vfs.get(), error, sizeof(error));
-  } catch (const MujocoError& e) {
-    SetMujocoWarningSink(old_sink);
-    if (vfs) mj_deleteVFS(vfs.get());
-    throw ConfigError(display_name, 0, "",
-                      std::string("MuJoCo could not load the model: ") + e.what());
+  {
+    const ScopedMujocoWarningSink sink(&loader_warnings);
+    try {
+      m = mj_loadXML(path.c_str(), vfs.get(), error, sizeof(error));
+    } catch (const MujocoError& e) {
+      if (vfs) mj_deleteVFS(vfs.get());
+      throw ConfigError(display_name, 0, "",
+                        std::string("MuJoCo could not load the model: ") + e.what());
+    }
   }
-  SetMujocoWarningSink(old_sink);
   if (vfs) mj_deleteVFS(vfs.get());
   const std::string msg = Trim(error);
   if (!m) {
