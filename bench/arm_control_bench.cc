@@ -7,7 +7,7 @@
 // bit-identical (same contacts, same solver work), so the difference is the controller plus
 // the simulation's controller scheduling (mj_step1 / mj_step2 split). both sides are timed
 // on thread CPU time, in alternating order. counters: steps/s of both sides and
-// ratio = controlled / replay (issue 3 asks for >= 0.9).
+// ratio = controlled / replay (the target: >= 0.9).
 //
 // the models are found through $PENUMBRA_MODELS_DIR, else in worlds/models above the
 // executable's folder (e.g. build/../worlds/models).

@@ -5,8 +5,8 @@
 // replay is bit-identical (same contacts, same solver work), so the difference is the
 // controller plus the simulation's controller scheduling (mj_step1 / mj_step2 split). both
 // sides are timed on thread CPU time (less disturbed by other processes than wall time), in
-// alternating order. counters: steps/s of both sides and ratio = controlled / replay (issue 3
-// asks for >= 0.9). optionally a third side replays the log through a controller that only
+// alternating order. counters: steps/s of both sides and ratio = controlled / replay (the
+// target: >= 0.9). optionally a third side replays the log through a controller that only
 // copies it into ctrl at every step: scheduling_ratio = that / replay is the part of the cost
 // that any controller running at every step pays.
 

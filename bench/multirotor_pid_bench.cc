@@ -5,7 +5,7 @@
 // contacts at takeoff), so the difference is the controller plus the simulation's controller
 // scheduling. both sides are timed on thread CPU time (less disturbed by other processes
 // than wall time), in alternating order. counters: steps/s of both sides and
-// ratio = controlled / replay (issue 3 asks for >= 0.9).
+// ratio = controlled / replay (the target: >= 0.9).
 //
 // the model is found through $PENUMBRA_MODELS_DIR, else in worlds/models above the
 // executable's folder (e.g. build/../worlds/models).

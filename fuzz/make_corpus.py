@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """writes the seed corpora of fuzz/corpus/ (docs/fuzzing.md): valid inputs of each parser and
-the known-bad cases of issue 33. standard library only; run from anywhere:
+known-bad inputs. standard library only; run from anywhere:
 
     python3 fuzz/make_corpus.py
 
@@ -111,7 +111,7 @@ def runlog_seeds():
     full = log()
     write("runlog", "cut_mid_chunk.plog", full[:len(full) - 30])
     body = step(0) + step(1, prev_xor=True) + step(2, prev_xor=True)
-    # issue 33: a steps chunk whose stored size is 2^64 - 4 (header CRC recomputed)
+    # a steps chunk whose stored size is 2^64 - 4 (header CRC recomputed)
     bad = chunk_header("steps", 1, 3, 0, 0, 2, len(body), 2**64 - 4) + body + \
         struct.pack("<I", crc(body))
     write("runlog", "stored_size_2pow64_minus4.plog", log(steps_chunk=bad))

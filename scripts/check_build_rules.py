@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks the rules that keep the build small (issue 34, "checks that keep it so"), beside
+"""Checks the rules that keep the build small, beside
 scripts/check_module_deps.py. The rules and their allow-lists live in scripts/build_rules.json:
 
   yaml-cpp        `#include <yaml-cpp/...>` only in src/penumbra/config/*.cc, or in a file of the

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks two rules of issue 34 that keep one vocabulary for the simulation state and for what
+"""Checks two rules that keep one vocabulary for the simulation state and for what
 a controller accepts (the build helper's checks live in their own script):
 
   - state-fields: MuJoCo's state arrays are named in one table. `qacc_warmstart` (the one

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Side by side with MuJoCo's own renderer (issue 36, item 6).
+"""Side by side with MuJoCo's own renderer.
 
 Renders bare models with Penumbra (`penumbra run MODEL.xml`: the auto-framed `default` camera,
 the bare-model daylight) and with MuJoCo 4's OpenGL renderer (tools/mujoco_offscreen.cc,

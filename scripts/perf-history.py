@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Render speed across builds of different commits (issue 37's bisect; docs/performance.md,
+"""Render speed across builds of different commits (docs/performance.md,
 "The bisect: where the default room's frames went").
 
 Each entry is LABEL=BINARY=WORLD: a `penumbra` binary and the world file of the same commit (an

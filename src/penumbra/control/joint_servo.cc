@@ -132,7 +132,7 @@ void JointServo::Bind(const ModelInfo& model, std::span<const int> ids,
                "); expected actuators[i] to drive joints[i] through a joint transmission");
     if (!(std::abs(act.gear[0]) > 0))
       Fail(c, akey, "actuator '" + act.name + "' has gear 0; expected a non-zero gear");
-    // torque output writes efforts: a servo would read them as targets (issue 17)
+    // torque output writes efforts: a servo would read them as targets
     if (params_.output == ServoOutput::kTorque && act.drive != ActuatorDrive::kMotor)
       Fail(c, akey,
            "actuator '" + act.name + "' is a " + ActuatorDriveName(act.drive) +

@@ -1,6 +1,6 @@
 #pragma once
 // PB_HOST_DEVICE marks a function that both processors run: the CPU backend and the CUDA
-// backend call the same definition, so a shading formula is written once (issue 35, item 3; as
+// backend call the same definition, so a shading formula is written once (as
 // pbrt-v4's PBRT_CPU_GPU, Pharr, Jakob and Humphreys, "Physically Based Rendering", 4th ed.,
 // section 1.7). compiled by nvcc (or clang in CUDA mode, both define __CUDACC__) it is
 // `__host__ __device__`; in plain C++ it is empty and such a function is an ordinary one.

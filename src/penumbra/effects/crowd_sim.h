@@ -1,5 +1,5 @@
 #pragma once
-// the crowd model of NPC agents with `motion: crowd` (issue 39; docs/npcs.md): goals, A* plans
+// the crowd model of NPC agents with `motion: crowd` (docs/npcs.md): goals, A* plans
 // on the walkable region of the agent's kind (effects/walkable_grid.h), reciprocal collision
 // avoidance among agents and against the robots (ORCA, effects/orca.h), and a kinematic bicycle
 // model for vehicles that follow lanes. the model is separate from physics: it steps at a fixed

@@ -1,5 +1,5 @@
 #pragma once
-// walkable regions of NPC agents (issue 39): the floor's occupancy grid (static geometry in the
+// walkable regions of NPC agents: the floor's occupancy grid (static geometry in the
 // band an agent kind can neither step over nor pass under, session/floor_map.h) inflated by
 // the agent's radius, restricted to the connected part reachable from a seed point, plus A*
 // planning on it.

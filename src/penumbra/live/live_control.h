@@ -1,6 +1,6 @@
 #pragma once
 // the live controls of a running world, as the bridges (ZeroMQ, ROS) and the browser viewer
-// reach them through their shared command dispatcher (issues 19 and 22): the adverse
+// reach them through their shared command dispatcher: the adverse
 // conditions (live/live_effects.h) and run-log recording (live/live_recorder.h). a run
 // (run/runner.h RunOptions::on_live) hands its LiveControl to the caller once it is set up.
 //

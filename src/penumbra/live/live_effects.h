@@ -1,6 +1,6 @@
 #pragma once
-// live changes of a running world's adverse conditions (issues 19 and 22: the bridges' and the
-// viewer's "set adversity preset / effect parameters at run time"): a whole adversity preset,
+// live changes of a running world's adverse conditions (set through the bridges and
+// the viewer while the run goes on): a whole adversity preset,
 // one block of the live preset (fog MOR, smoke extinction, rain and snow rate, light scale,
 // NPC count), or the parameters of one effect, changed, added or removed while the run goes on.
 //
@@ -19,9 +19,10 @@
 // the effect's name and type (effects/effects_engine.h), so a change leaves the other effects'
 // particles and noise where they were; stateful fluids (plume smoke, fire) are re-stepped from
 // t = 0 with their new parameters. NPCs: a run cannot add bodies to its loaded model (the
-// physics state and every index would change mid-run), so a run has the NPC bodies of the preset it started with, plus, in a live run, parked bodies
-// for the NPCs of the bundled presets (SessionOptions::reserve_live_npcs); a change may move
-// them onto other paths or park them (100 m below the floor) but not add more.
+// physics state and every index would change mid-run), so a run has the NPC bodies of the preset it
+// started with, plus, in a live run, parked bodies for the NPCs of the bundled presets
+// (SessionOptions::reserve_live_npcs); a change may move them onto other paths or park them (100 m
+// below the floor) but not add more.
 //
 // recording: every applied change is handed to the on_applied callback (LiveControl records
 // it as a run-log event "live" with the change's JSON, docs/run-log.md "Live changes"), and a

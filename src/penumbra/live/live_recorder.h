@@ -1,6 +1,6 @@
 #pragma once
-// a run log (docs/run-log.md) started and stopped while the run goes on (issue 19's "start/stop
-// recording"; the viewer's record button): the log's header is that of a log the run would
+// a run log (docs/run-log.md) started and stopped while the run goes on (the bridges' start/stop
+// recording; the viewer's record button): the log's header is that of a log the run would
 // have written with --record, its first step record is the step at which the recording
 // started, with the live changes applied before it (live/live_effects.h) as "live" events
 // at that step, and it ends complete (end chunk) at the step at which it was stopped, so that

@@ -1,6 +1,6 @@
 #pragma once
 // the realtime media volumes' per-cell and per-column build (RealtimeMedia::Build, render/
-// media_realtime.h), written once for the CPU and the CUDA backend's kernels (branch gpu15):
+// media_realtime.h), written once for the CPU and the CUDA backend's kernels:
 //  - the world light volume, one cell at a time (LightVolumeCellCentre, LightVolumeCellLight):
 //    per light the channel-mean transmittance Th Tgrid to the light (the homogeneous media's
 //    closed form times every grid's light volume at the shadow ray's entry into its box) and,
@@ -14,14 +14,13 @@
 //    lobes), times the transmittance from the camera (media and grid froxels), accumulated in
 //    slice order;
 //  - the grids' light volumes, one cell at a time (GridLightCellCentre, GridLightCellLight,
-//    GridLightCellSource; branch gpu17): per light the transmittance through the grid from the
+//    GridLightCellSource): per light the transmittance through the grid from the
 //    cell centre (kGridLightSteps steps of MediaGridDensity, render/media_scene_math.h) and the
 //    shadow ray its in-scatter source asks, then the source (the sky, and each light seen);
 //  - the grid froxels, one column at a time (GridFroxelColumnInterval, then per slice
 //    GridFroxelSlice and GridFroxelRecords, which accumulates the slices in slice order).
-// operation order: the CPU code's before the move (the bit-for-bit rule of shading_math.h);
-// the CPU's images did not change (docs/gpu-notes.md, "Media volumes built on the GPU" and
-// "Grid media volumes built on the GPU (branch gpu17)").
+// operation order: the CPU's, bit for bit (the rule of shading_math.h; docs/gpu-notes.md,
+// "Media volumes built on the GPU" and "Grid media volumes built on the GPU").
 
 #include <stdint.h>
 
@@ -135,7 +134,7 @@ PB_HOST_DEVICE inline uint8_t LightVolumeCellLight(const LightVolumeBuild& b, co
 /// stride lights per cell; with_visibility: also its visibility, with one shadow ray per cell
 /// and light traced where LightVolumeCellLight asks) and the fog froxels (fog_nx x fog_ny
 /// columns with their axis tables; jitter FroxelColumnJitter of frame_key, stream 3).
-/// grids (branch gpu17): the grids' light volumes (layouts RealtimeMediaView::grids, their
+/// grids: the grids' light volumes (layouts RealtimeMediaView::grids, their
 /// [light][cell] transmittances end to end at GridLightPod::offset, their in-scatter sources
 /// [cell] end to end in grid order) and the grid froxels (grid_nx x grid_ny columns with their
 /// axis tables; jitter stream 2), over the grids' densities `grid_media` (num_grids of them,

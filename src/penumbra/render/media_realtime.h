@@ -53,7 +53,7 @@
 // volume; outside it: closed form for the homogeneous media times the grid's light volume at
 // the shadow ray's entry into the grid box).
 // random numbers: the froxel columns' jitter, from their centre pixels' streams 2 and 3.
-// written once for a device (render/media_build_math.h, branches gpu15 and gpu17): the world
+// written once for a device (render/media_build_math.h): the world
 // light volume's cells (LightVolumeCellLight), the fog froxels' columns (FogFroxelColumn), the
 // grids' light volumes' cells (GridLightCellLight, GridLightCellSource) and the grid froxels'
 // columns (GridFroxelSlice, GridFroxelRecords); Build's device_volumes leaves all four to the

@@ -25,9 +25,9 @@
 //    and grids) as plain data (RealtimeMedia::HostView; device copies for a GPU path) and,
 //    composed of the functions above, a pixel's view segment (IntegrateView, per pixel or with a
 //    quad's shared lookups) and a surface point's transmittance to a light (the CPU realtime
-//    surface loop's); RealtimeMedia's member functions call these (branch gpu12).
-// operation order: the CPU code's before the move (bit-for-bit rule of shading_math.h); the
-// CPU's images did not change (docs/gpu-notes.md, "Homogeneous media (branch gpu8)").
+//    surface loop's); RealtimeMedia's member functions call these.
+// operation order: the CPU's, bit for bit (the rule of shading_math.h; docs/gpu-notes.md,
+// "Homogeneous media").
 //
 // record types: the froxel lookups are templates over their record type R, an rgb value with a
 // 4th lane that is 0 (Eigen::Array4f on the CPU, whose SSE lanes round as the scalar

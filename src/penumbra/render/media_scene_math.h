@@ -4,7 +4,7 @@
 // over its own arrays and its members call these (At, Transmittance, Track, MediumPoint's Phase
 // and SamplePhase, GridVolume's DensityAt / EmissionAt / Interval), and the CUDA backend's path
 // kernels (render/cuda/path_shading.h) call the same definitions over device copies of the
-// arrays (branch gpu14).
+// arrays.
 //  - SampleHenyeyGreensteinDir: the Henyey-Greenstein phase function's sampling (render/
 //    media_common.h's SampleHenyeyGreenstein calls it; the function itself is MediaPhaseHG);
 //  - MediumHeightDensity: a homogeneous medium's relative density at a height
@@ -16,11 +16,10 @@
 //  - MediaTransmittanceOf: exact transmittance of the homogeneous media times ratio tracking in
 //    the grids (MediaScene::Transmittance); MediaTrackOf: spectral delta tracking of a free
 //    flight (MediaScene::Track). models and sources: render/media_scene.h.
-// operation order: the CPU code's before the move (Eigen's per-coefficient order, its 3x3
-// product as GridToFrame, its maxCoeff as max(max(x, y), z)); the CPU's images did not change
-// (docs/gpu-notes.md, "Media in the pathtraced tier on the GPU (branch gpu14)"), and
-// tests/render/media_scene_math_test.cc checks the functions bit for bit against the Eigen code
-// they replaced. random numbers: the caller's Rng, drawn in the CPU's order.
+// operation order: the Eigen code's (per coefficient, its 3x3 product as GridToFrame, its
+// maxCoeff as max(max(x, y), z); docs/gpu-notes.md, "Media in the pathtraced tier on the GPU"),
+// and tests/render/media_scene_math_test.cc checks the functions bit for bit against Eigen.
+// random numbers: the caller's Rng, drawn in the CPU's order.
 
 #include <math.h>
 #include <stddef.h>

@@ -1,6 +1,6 @@
 #pragma once
-// the mirror layer's importance sampling as formulas both backends can call (issue 37 point 2,
-// render/cpu/mirror_layer.h; PB_HOST_DEVICE, core/host_device.h; the shared shading contract:
+// the mirror layer's importance sampling as formulas both backends can call
+// (render/cpu/mirror_layer.h; PB_HOST_DEVICE, core/host_device.h; the shared shading contract:
 // Eigen-free, no std:: containers): which grid a mirror weight is traced on, the bilinear
 // weights of a pixel between traced grid pixels, and the layer's blend.
 

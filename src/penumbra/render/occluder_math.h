@@ -1,5 +1,5 @@
 #pragma once
-// the exact ray-box test of the sun-occluder map (render/sun_occluder_map.h, issue 37 point 3)
+// the exact ray-box test of the sun-occluder map (render/sun_occluder_map.h)
 // as a formula both backends can call (PB_HOST_DEVICE, core/host_device.h; the shared shading
 // contract: Eigen-free).
 

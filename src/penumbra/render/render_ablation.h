@@ -10,7 +10,7 @@ namespace penumbra {
 struct RenderAblation {
   bool mirror = true;          ///< the mirror layer (SurfaceMaterial::mirror); off: mirror 0
   bool mirror_sparse = true;   ///< weak mirrors at a quarter of the pixels (cpu/mirror_layer.h);
-                               ///< off: a reflected ray at every pixel (as before issue 37)
+                               ///< off: a reflected ray at every pixel
   bool sky_volume = true;      ///< occluded sky light (SkyIrradianceVolume); off: unoccluded
   bool texture_filter = true;  ///< ray-cone texture filtering; off: bilinear in level 0
   bool shadows = true;         ///< shadow rays; off: every light sample counts as visible

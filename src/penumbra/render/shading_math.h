@@ -1,5 +1,5 @@
 #pragma once
-// the vocabulary of the shading formulas both backends run (issue 35, item 3; the contract:
+// the vocabulary of the shading formulas both backends run (the contract:
 // docs/gpu.md, "One shading code"). a formula is written once, as a PB_HOST_DEVICE function in
 // a render/ root header (brdf_math.h, light_math.h, film_math.h, texture_math.h), and called by
 // the CPU backend (render/cpu/) and by the CUDA kernels (render/cuda/*.cu).

@@ -1,6 +1,6 @@
 #pragma once
 // the realtime tier's shared shadow verdicts for lights with an extent (sphere lamps, the sun's
-// disc) as formulas both backends call (issue 35 item 3; PB_HOST_DEVICE, core/host_device.h;
+// disc) as formulas both backends call (PB_HOST_DEVICE, core/host_device.h;
 // the shared shading contract: Eigen-free, no std:: containers). a pixel's visibility of such
 // a light is the ratio estimator of Heitz, Hill and McGuire, "Combining Analytic Direct
 // Illumination and Stochastic Shadows" (I3D 2018) with the shadow term shared: the weighted

@@ -1,6 +1,6 @@
 #pragma once
 // the per-drop decision of ParticleStreaks::Build (render/particle_streaks.h) written once for
-// the CPU and the CUDA backend's device culling (render/cuda/cuda_streak_cull.h, branch gpu27): a
+// the CPU and the CUDA backend's device culling (render/cuda/cuda_streak_cull.h): a
 // drop is nothing (no radius, sheltered, behind the near plane, outside the camera's view
 // pyramid), a rain streak culled as invisible (kRainCullContrast over the homogeneous media's
 // transmittance) or a streak (its far end, widened radius and coverage). plain data only (Float3,

@@ -1,6 +1,6 @@
 #pragma once
 // which sun shadow rays the static geometry provably blocks, so that the realtime tier need not
-// trace them (issue 37: inside the house and the warehouse ~100 % of the sun's shadow rays are
+// trace them (inside the house and the warehouse ~100 % of the sun's shadow rays are
 // occluded). conservative: the map never skips a ray that would reach the sun; a skipped ray is
 // one the exact test (RayScene::Occluded) reports as occluded, so the image is the same.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// the run log (.plog): a versioned, chunked binary record of one `penumbra run` (issue 18):
+// the run log (.plog): a versioned, chunked binary record of one `penumbra run`:
 // a header (versions, the world and composed model texts, asset hashes, seed, command line,
 // timestep and the state layout with names), then per physics step the state MuJoCo needs to
 // continue bit for bit, plus events (commands, effect changes, notes) and optional

@@ -1,5 +1,5 @@
 #pragma once
-// the crowd of a run (issue 39; docs/npcs.md): a CrowdSim (effects/crowd_sim.h) advanced from the
+// the crowd of a run (docs/npcs.md): a CrowdSim (effects/crowd_sim.h) advanced from the
 // agents' mocap drivers on the physics thread. the crowd steps at its own dt (0.05 s) on sim
 // time; each step reads the robots' root poses from the simulation (a robot without a free
 // joint stands at its world-file pose), and the agents' poses between two crowd steps are

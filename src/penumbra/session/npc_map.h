@@ -1,5 +1,5 @@
 #pragma once
-// the walkable map of a world's NPCs (issue 39; docs/npcs.md): the walkable regions of people
+// the walkable map of a world's NPCs (docs/npcs.md): the walkable regions of people
 // and of vehicles on one floor (effects/walkable_grid.h), built from the static geometry at the
 // start in each kind's height band (session/floor_map.h), and its picture (`penumbra npc-map`,
 // npc_map.png in a run's folder).

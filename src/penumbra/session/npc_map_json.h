@@ -1,5 +1,5 @@
 #pragma once
-// a run's crowd map as data (issue 39; docs/npcs.md "The walkable map in the viewer"): what the
+// a run's crowd map as data (docs/npcs.md "The walkable map in the viewer"): what the
 // viewer's scene view draws on the floor (the scene message's "npc_map") and what a run saves
 // next to npc_map.png (npc_map.json).
 

@@ -5,7 +5,7 @@
 // hits shaded as the tier shades what the camera sees, one sample of every light with a
 // shadow ray).
 //
-// importance (issue 37): L_m costs more than the pixel's own shading (it is traced and shaded
+// importance: L_m costs more than the pixel's own shading (it is traced and shaded
 // one pixel at a time), so a 5 % floor traced at every pixel cost 2.4-2.9x the frame. the
 // layer is sampled by its weight: pixels with r >= kMirrorDenseReflectance (real mirrors,
 // polished metal) trace their own L_m, as before; below it L_m is traced on a grid of every

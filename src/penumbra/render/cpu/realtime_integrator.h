@@ -25,9 +25,9 @@
 // light's share of the pixel's unshadowed luminance asks for (PenumbraLatticePoints: a faint
 // lamp's penumbra needs few); a tile's outermost penumbra pixels, whose window the tile edge
 // cuts, trace that many of the 64 points themselves (64, 32, 16 or 4), and a lamp's fraction is
-// averaged once more over 3x3 pixels. the further points' rays go as 16-wide packets. before (issue
-// 36): one random point per pixel and frame: salt-and-pepper speckle wherever a lamp is partly
-// hidden or near the horizon, and different speckle every frame.
+// averaged once more over 3x3 pixels. the further points' rays go as 16-wide packets. why a
+// lattice: one random point per pixel and frame gives salt-and-pepper speckle wherever a lamp is
+// partly hidden or near the horizon, and different speckle every frame.
 //
 // shadow rays are skipped for lights that contribute less than kNegligibleLight of the
 // pixel's unshadowed radiance (their contribution is added unshadowed). random numbers: only
