@@ -1,5 +1,5 @@
 // `penumbra export` against run folders from someone else and against interrupts and full
-// disks (issue 33), on the real binary: a symbolic link in the run folder is refused (nothing
+// disks, on the real binary: a symbolic link in the run folder is refused (nothing
 // read through it, nothing exported); a truncated or mis-sized PNG is refused, naming it;
 // SIGINT / SIGTERM leave no partial dataset, bag or replay folder and the next export to the
 // same place succeeds; a rosbag export to a full 2 MiB tmpfs exits 1 with the system's reason

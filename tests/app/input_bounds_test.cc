@@ -1,4 +1,4 @@
-// issue 33, with the real binary: a recorded run log whose first steps chunk declares a stored
+// with the real binary: a recorded run log whose first steps chunk declares a stored
 // size of 2^64 - 4 (the chunk scan's size + CRC sum wrapped and `replay`, `replay --resimulate`
 // and `export` died of SIGSEGV) or 3.2 GB of content in a 14-byte zstd frame (the reader
 // allocated it before zstd found the frame short) is refused with a message and without

@@ -1,4 +1,4 @@
-// issue 15 points 1, 2 and 8 through `penumbra run`: absurd but finite inputs exit 2 with a
+// through `penumbra run`: absurd but finite inputs exit 2 with a
 // message that names the file and key (or the MJCF geom / camera) instead of aborting in Embree
 // (SIGABRT), hanging, or dying of std::bad_alloc. each run goes through RunCli in a child process
 // with an alarm, so a regression that hangs fails the test instead of stalling the suite.

@@ -1,4 +1,4 @@
-// the real `penumbra` binary on the outputs and commands of issue 38: a bad --adversity value
+// the real `penumbra` binary on its outputs and commands: a bad --adversity value
 // is the flag's error, the pathtraced tier reports its sample passes, `bench render` says
 // whether its target was met, and a robot that lies on its back is reported fallen in
 // run.json.

@@ -1,4 +1,4 @@
-// issue 36, item 4: the bundled rain and snow example worlds show precipitation. their cameras
+// the bundled rain and snow example worlds show precipitation. their cameras
 // are outdoors (rain and snow fall only under open sky), so the first frames of the rover's
 // camera differ from the same frames without the world's effects in many pixels: streaks,
 // flakes and lens droplets (more than 1 % of the pixels change by more than 4 codes).
@@ -10,8 +10,8 @@
 #include <filesystem>
 #include <string>
 
-#include "penumbra/run/runner.h"
 #include "penumbra/output/png_io.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

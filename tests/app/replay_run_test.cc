@@ -1,5 +1,5 @@
 // `penumbra replay` as users run it (the real binary in a child process), on logs recorded by
-// `penumbra run --record`: issue 18's acceptance for replay. a 20 s default-world recording
+// `penumbra run --record`: the acceptance test of replay. a 20 s default-world recording
 // resimulates bit-exact and replays its frames byte for byte; under --adversity major the camera
 // trajectory (frames.csv) stays and the images change, also in a world whose agents pushed the
 // robot; an override changes a camera's resolution and adds one, both along the logged path.
@@ -376,7 +376,7 @@ TEST(ReplayRunTest, ACutLogReplaysToItsLastCompleteChunk) {
   EXPECT_NE(manifest.find("log ends at chunk "), std::string::npos) << manifest;
 }
 
-// issue 33: a log with one flipped byte in a steps chunk is damaged, never "bit-exact": the
+// a log with one flipped byte in a steps chunk is damaged, never "bit-exact": the
 // verdict names the chunk and its steps and the exit status is 1
 TEST(ReplayRunTest, ResimulateOfALogWithAFlippedStepByteReportsTheDamageAndFails) {
   testing::TempDir tmp;

@@ -494,7 +494,7 @@ TEST_F(RunOutputsTest, DivergenceRecordsTheSimTimeReached) {
 namespace penumbra {
 namespace {
 
-// issue 38: a world with a mesh model writes meshes/<stem>-<hash>.msh and .xml beside
+// a world with a mesh model writes meshes/<stem>-<hash>.msh and .xml beside
 // composed.xml; running it again into the same folder with --force replaces that run (it
 // refused them as "files Penumbra did not write")
 TEST(RunOutputsMeshes, ForceReplacesARunWhoseWorldHasAMeshModel) {

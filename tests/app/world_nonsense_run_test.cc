@@ -1,4 +1,4 @@
-// issue 33 point 8 on the real binary: nonsense that `penumbra run` used to accept silently now
+// on the real binary: nonsense that `penumbra run` used to accept silently now
 // exits 2 naming the file:line (world files) or the flag (command line), or gets a warning:
 // `fovy_deg: 1e-300` (fx = 2.75e303), a YAML tag, `--out ""` (fell back to the world's folder),
 // a 100 KB camera name (exit 1, no line, 100 KB of stderr), and black frames (a world without
@@ -168,7 +168,7 @@ TEST_F(WorldNonsenseRunTest, ALitWorldDoesNotWarn) {
 }
 
 TEST(RunBudgetPathSamples, HugeSampleCountsOfThePathtracedTierAreWarned) {
-  // the issue's case: --spp 65536 at 64 x 48, about 20 minutes a frame; 1 s at 10 Hz
+  // the reported case: --spp 65536 at 64 x 48, about 20 minutes a frame; 1 s at 10 Hz
   WorldConfig world;
   world.duration_sec = 1;
   world.render.tier = RenderSettings::Tier::kPathtraced;

@@ -1,4 +1,4 @@
-// issue 21 point 1: mesh files imported through assimp in metres, z up, with their PBR maps.
+// mesh files imported through assimp in metres, z up, with their PBR maps.
 #include "penumbra/assets/mesh_import.h"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// `collision: coacd` on a world-file mesh model (issue 21, convex decomposition in the world
+// `collision: coacd` on a world-file mesh model (convex decomposition in the world
 // file): the model collides as CoACD's convex parts, so a ball dropped into a U-shaped mesh
 // lands between its posts, where MuJoCo's single convex hull of the mesh would hold it on an
 // invisible lid; the parts come from the on-disk cache the second time; bad input is named.

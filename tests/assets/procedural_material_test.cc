@@ -1,4 +1,4 @@
-// issue 21 point 5: procedural PBR materials, deterministic per seed, at physical scale.
+// procedural PBR materials, deterministic per seed, at physical scale.
 #include "penumbra/assets/procedural_material.h"
 
 #include <gtest/gtest.h>

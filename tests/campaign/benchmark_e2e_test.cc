@@ -1,4 +1,4 @@
-// the acceptance test of issue 20's SLAM half: a short spec (one world, 2 conditions, 2
+// the acceptance test of the SLAM benchmark: a short spec (one world, 2 conditions, 2
 // trials, OpenCV RGB-D odometry) through the real `penumbra benchmark` (recording, local
 // worker processes, replays, TUM export, methods as processes, evaluation, report).
 

@@ -1,4 +1,4 @@
-// issue 33 point 4 through the real `penumbra benchmark`: shell text in a value (the output
+// through the real `penumbra benchmark`: shell text in a value (the output
 // folder, hence the dataset, output and work folder paths) reaches the method as one literal
 // argument and runs nothing; the command.sh written for people runs the same argument vector;
 // a Slurm batch script quotes every value and refuses paths it cannot carry (a newline in
@@ -70,7 +70,7 @@ std::vector<std::string> SplitNul(const std::string& s) {
 
 TEST(BenchmarkInjection, ShellTextInPathsReachesTheMethodAsOneLiteralArgument) {
   TempDir dir;
-  // the issue's template: {output} inside double quotes, beside single-quoted and bare values
+  // the reported template: {output} inside double quotes, beside single-quoted and bare values
   const std::string spec = dir.Write("spec.yaml", InjectionSpec(R"X(  - name: argv
     command: >-
       /usr/bin/python3 -c 'import sys; sys.stdout.write("\0".join(sys.argv[1:]))'

@@ -1,4 +1,4 @@
-// issue 33 point 7 for `penumbra benchmark`, through the real binary: SIGINT while methods
+// `penumbra benchmark` interrupted, through the real binary: SIGINT while methods
 // run exits 130, every method process is gone, and no job folder is left half-written
 // (interrupted jobs are removed, the report holds only finished jobs); SIGTERM while a route
 // is being recorded exits 143 at once and keeps no partial recording; SIGINT during a nav

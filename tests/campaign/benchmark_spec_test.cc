@@ -113,7 +113,7 @@ TEST(BenchmarkSpec, CommandsAreSplitAtLoadAndShellSyntaxIsRefusedWithFileLineAnd
                                       "--intrinsics", "{fx},{fy},{cx},{cy}"}));
   EXPECT_EQ(s.methods[1].command_words,
             (std::vector<std::string>{"/opt/x/run", "a b", "{dataset}/associations.txt"}));
-  // the template: a value in double quotes beside a command substitution
+  // the reported template: a value in double quotes beside a command substitution
   std::string e = ErrorOf(Spec("", "  - {name: x, command: 'run \"$(cat {dataset})\"'}\n"));
   EXPECT_NE(e.find("spec.yaml:10: methods[0].command: column 6: '$' inside"), std::string::npos)
       << e;

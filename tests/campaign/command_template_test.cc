@@ -105,7 +105,7 @@ TEST(CommandTemplate, RefusesWhatOnlyAShellWouldDo) {
   EXPECT_NE(TemplateRefusal("run {dataset} ; rm x").find("column 15: ';' separates commands"),
             std::string::npos)
       << TemplateRefusal("run {dataset} ; rm x");
-  // the case: a placeholder in double quotes next to a command substitution
+  // the reported case: a placeholder in double quotes next to a command substitution
   EXPECT_NE(TemplateRefusal("run \"$(cat {dataset})\"").find("'$' inside \"...\""),
             std::string::npos)
       << TemplateRefusal("run \"$(cat {dataset})\"");
@@ -147,7 +147,7 @@ TEST(CommandTemplate, NoPlaceholderReachesTheCodeOfAShellOrAnInterpreter) {
     const char* reason;
   };
   for (const Case& c : std::vector<Case>{
-           // the two templates: `--` ended the old option scan, -m stopped it
+           // the two reported templates: `--` ended the old option scan, -m stopped it
            {"sh -c -- 'true {output}'",
             "word 4 'true {output}': a placeholder inside the inline "
             "program of 'sh -c'"},

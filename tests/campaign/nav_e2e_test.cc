@@ -1,4 +1,4 @@
-// issue 20's nav acceptance, parts (b) and (c), through the real `penumbra benchmark` with a
+// the nav benchmark's acceptance, parts (b) and (c), through the real `penumbra benchmark` with a
 // `kind: nav` spec: every job starts a real lockstep `penumbra run --zmq` and a real method
 // process (the bundled python3 -m penumbra_nav, or tests/campaign/straight_driver.py), and the
 // harness judges the episode from the run's own pose and contact series.

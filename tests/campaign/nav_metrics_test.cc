@@ -1,4 +1,4 @@
-// issue 20's nav acceptance, part (a): the harness's collision debounce and SC (Eftekhar et
+// the nav benchmark's acceptance, part (a): the harness's collision debounce and SC (Eftekhar et
 // al. 2024: SC = mean over episodes of S_i / (1 + c_i)) on hand-made episodes, the episode
 // judgement (time to goal, fall, timeout) on hand-made pose series, and the summary's mean
 // +- std over trials.

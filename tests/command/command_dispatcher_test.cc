@@ -150,7 +150,7 @@ TEST_F(CommandDispatcherTest, StepNeedsAPausedRunAndEndsWithTheRun) {
   EXPECT_EQ(after.at("error").at("code"), "run_ended") << after.dump();
 }
 
-// issue 33: once a `stop` is queued, a start_recording would get no step; it is refused with
+// once a `stop` is queued, a start_recording would get no step; it is refused with
 // `stopping` (before anything else is checked), also when it arrives while the run finishes
 TEST_F(CommandDispatcherTest, StartRecordingAfterAStopIsRefusedWithStopping) {
   LiveLoop live(world_, 1.0);

@@ -1,4 +1,4 @@
-// issue 17 point 7: a joint effort becomes the ctrl that the actuator's own force law turns
+// a joint effort becomes the ctrl that the actuator's own force law turns
 // back into that effort (motors, position servos, velocity servos), within forcerange and
 // ctrlrange; actuators of other kinds are named with their type.
 #include "penumbra/control/actuator_drive.h"

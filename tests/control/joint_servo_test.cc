@@ -231,7 +231,7 @@ namespace {
 
 using namespace arm_fake;  // NOLINT(build/namespaces)
 
-// issue 17 point 7: torque output on a position servo (a Menagerie arm's <position>) would
+// torque output on a position servo (a Menagerie arm's <position>) would
 // write efforts as joint targets; it is refused naming the actuator and its type
 TEST(JointServo, TorqueOutputRefusesServoActuators) {
   ModelInfo m = ArmModel();

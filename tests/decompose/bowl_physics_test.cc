@@ -1,9 +1,9 @@
-// the bowl of the acceptance (issue 21): decomposed, every part's concavity is under the
+// the bowl of the acceptance: decomposed, every part's concavity is under the
 // threshold, and a sphere dropped into it (MuJoCo, one convex mesh geom per part) comes to rest
 // inside it, near the bottom; dropped onto the plain convex hull of the same bowl it rests on
 // the hull's lid at the rim. this is what convex decomposition is for.
 //
-// KNOWN GAP: the issue asks for the union of the parts within 2 % of the mesh volume; for this
+// KNOWN GAP: the target is the union of the parts within 2 % of the mesh volume; for this
 // thin hemispherical shell (5 cm wall, 45 cm inner radius) the hulls add about 21 % at the
 // threshold, because each part's hull spans the chord of the inner sphere (a bulge of up to the
 // threshold, 2.5 cm, on a 5 cm wall). 2 % would need a bulge under ~1.5 mm: some 300 parts,

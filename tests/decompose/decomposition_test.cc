@@ -1,4 +1,4 @@
-// the acceptance of convex decomposition (issue 21): an L and a U decompose
+// the acceptance of convex decomposition: an L and a U decompose
 // into convex parts whose union is within 2 % of the mesh volume (the sum of the part hulls'
 // volumes, an upper bound of the union, is checked), every part's concavity is under the
 // threshold, no hull sticks out of the mesh by more than the threshold, the parts are the

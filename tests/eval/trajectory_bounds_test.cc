@@ -1,4 +1,4 @@
-// issue 33: a TUM file is regular text of bounded size: /dev/zero (not a regular file), a file of
+// a TUM file is regular text of bounded size: /dev/zero (not a regular file), a file of
 // NULs and an endless line are refused at once with the file and line, and so are coordinates no
 // robot reaches (1e308 printed NaN metrics and exit 0) and timestamps beyond the year 2286.
 

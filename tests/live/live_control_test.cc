@@ -313,7 +313,7 @@ TEST(LiveControlTest, NpcsOfTheStartingPresetMoveOrParkAndTheRestStayBitExact) {
   EXPECT_EQ(live_session.effects().agents().size(), 1u);
 }
 
-// what the viewer's controls show (issue 38): the preset as requested, its name, whether a
+// what the viewer's controls show: the preset as requested, its name, whether a
 // block was changed since, and a count of accepted changes; a refused change leaves it
 TEST(LiveControlTest, RequestedAdversityFollowsEveryAcceptedChange) {
   const WorldConfig world = LoadWorldFile((kWorlds / "effects" / "fog.yaml").string());

@@ -132,7 +132,7 @@ TEST(RunLogRecordingTest, TheHeaderMapsTheStateByNameAndHashesTheFilesRead) {
   EXPECT_EQ(models, 2);
 }
 
-// issue 33: a live recording started as the run stops gets no step; it is removed, not left as
+// a live recording started as the run stops gets no step; it is removed, not left as
 // an empty log, and once the loop has finished no recording can start
 TEST(RunLogRecordingTest, ALiveRecordingThatGotNoStepIsRemovedAndNoneStartsAfterTheEnd) {
   testing::TempDir tmp;

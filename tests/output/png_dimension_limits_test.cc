@@ -1,4 +1,4 @@
-// issue 33: a PNG's declared size is checked before its rows are allocated: a 60-byte file that
+// a PNG's declared size is checked before its rows are allocated: a 60-byte file that
 // declares 20000 x 20000 or 1000000 x 1000000 pixels is refused with a message naming it (the
 // reader allocated width x height x channels first and died of std::bad_alloc), and the same
 // caps hold for the header peek that guards OpenCV's decoders (core/image_file_limits.h).

@@ -1,4 +1,4 @@
-// issue 17 point 7: trot_gait on a quadruped whose legs have position servos (as Menagerie's
+// trot_gait on a quadruped whose legs have position servos (as Menagerie's
 // Go1 has stock <position> actuators) drives them through their kp/kv and walks as with
 // torque motors; actuators whose force cannot be set are refused with an error naming the
 // actuator and its type instead of being misread.

@@ -1,4 +1,4 @@
-// spatial tendons (issue 17 point 3): the scene lists the visible spatial tendons with their
+// spatial tendons: the scene lists the visible spatial tendons with their
 // width and colour, and every snapshot carries their wrap-point paths in the world frame.
 
 #include <gtest/gtest.h>

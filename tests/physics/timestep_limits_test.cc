@@ -1,4 +1,4 @@
-// issue 15 point 2: a degenerate physics timestep, from the MJCF <option timestep> or from the
+// a degenerate physics timestep, from the MJCF <option timestep> or from the
 // override (physics.timestep_sec), is refused at load. timestep="0" used to loop forever,
 // "-0.01" ran backwards, "1" overran short runs and 1e-300 never finished. the checks run at
 // load, so these tests cannot hang whatever Simulation::Step does.

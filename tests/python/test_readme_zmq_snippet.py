@@ -1,5 +1,5 @@
-"""README.md's ZeroMQ snippet ("Live runs: ZeroMQ"), run as written against the real server
-(issue 38): the block after the `<!-- test: zmq-snippet` marker is read from README.md, so the
+"""README.md's ZeroMQ snippet ("Live runs: ZeroMQ"), run as written against the real server:
+the block after the `<!-- test: zmq-snippet` marker is read from README.md, so the
 test fails when the README drifts. Its first line starts the server in the background (`&`),
 the rest is one `python3 -c` command; both are split as a POSIX shell would (shlex, no shell
 runs) and run from the repository root, with `./build/penumbra` replaced by $PENUMBRA_BINARY

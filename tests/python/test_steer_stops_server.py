@@ -1,4 +1,4 @@
-"""python/examples/steer_to_target.py stops the server it drove (issue 38: it left it running):
+"""python/examples/steer_to_target.py stops the server it drove:
 on a normal exit and on Ctrl-C (SIGINT) it sends `stop`, and the real `penumbra run --zmq
 --lockstep` process exits (130, as on Ctrl-C) and writes run.json with "interrupted": true;
 with --leave-running the server keeps running."""

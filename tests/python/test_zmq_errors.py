@@ -1,4 +1,4 @@
-"""Acceptance (issue 19): malformed msgpack, an oversized frame, wrong field types and an unknown
+"""Acceptance: malformed msgpack, an oversized frame, wrong field types and an unknown
 command each get an error reply from a real `penumbra run --zmq`, and the next valid request
 works; the client raises the error class of each code."""
 

@@ -1,4 +1,4 @@
-"""Acceptance (issue 19): the Python client runs 1000 lockstep steps of the quadruped world
+"""Acceptance: the Python client runs 1000 lockstep steps of the quadruped world
 against a real `penumbra run --zmq --lockstep`, receives every camera frame due, and two runs
 give identical images and states."""
 

@@ -1,4 +1,4 @@
-// the realtime tier's light from lamps with an extent (issue 36, item 5): a white ceiling next
+// the realtime tier's light from lamps with an extent: a white ceiling next
 // to a small spherical lamp without per-pixel noise at one frame, the same picture every frame,
 // the analytic horizon-clipped sphere irradiance (render/lamp_math.h), no sky light leaking
 // into the foot of a box standing on a floor slab, and the tile loop's skip of a light wholly
@@ -173,7 +173,7 @@ TEST(LampLightingTest, PenumbraBudgetFollowsTheLightsShare) {
 }
 
 TEST(LampLightingTest, FaintLampsPenumbraTakesFewerRays) {
-  // issue 37: a pixel in a lamp's penumbra traces as many lattice points as the lamp's share of
+  // a pixel in a lamp's penumbra traces as many lattice points as the lamp's share of
   // its light asks for (PenumbraLatticePoints). the fixture's penumbra on the ceiling, lit by the
   // lamp alone (A: 64 points per window, all 64 on a tile's edge pixels) and with a 20 000 cd
   // point light 2.2 m below the ceiling beside it (B: there the lamp gives 1-10 % of a pixel's

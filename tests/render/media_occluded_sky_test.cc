@@ -1,5 +1,5 @@
 // fog and particles lit by the sky the static geometry lets through (SkyIrradianceVolume::
-// AmbientRadiance), issue 20 point 4: a closed room under a bright sky must not fill its fog
+// AmbientRadiance): a closed room under a bright sky must not fill its fog
 // with sky light, while fog under the open sky keeps Koschmieder's sky in-scatter.
 
 #include <gtest/gtest.h>

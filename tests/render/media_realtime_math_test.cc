@@ -404,9 +404,9 @@ bool SameRgb(const Eigen::Array4f& a, const Rgb4& b) {
   return SameBits(a[0], b.x) && SameBits(a[1], b.y) && SameBits(a[2], b.z);
 }
 
-// RealtimeMedia's grid light volumes and grid froxels as Build and BuildFroxels made them before
-// branch gpu17 moved them to media_build_math.h's shared functions (the Eigen code, serial, one
-// shadow ray at a time): the reference of GridVolumesAreTheFormerEigenCodesBitForBit.
+// RealtimeMedia's grid light volumes and grid froxels computed with the Eigen code, serial, one
+// shadow ray at a time, apart from media_build_math.h's functions: the reference of
+// GridVolumesAreTheFormerEigenCodesBitForBit.
 struct FormerGridVolumes {
   std::vector<float> T;                 // [grid][light][cell] end to end
   std::vector<Eigen::Vector3f> source;  // [grid][cell] end to end

@@ -1,4 +1,4 @@
-// MuJoCo's material `reflectance` (issue 17 point 2): a mirror layer on planes and the +z faces
+// MuJoCo's material `reflectance`: a mirror layer on planes and the +z faces
 // of boxes, drawn by both tiers.
 
 #include <gtest/gtest.h>

@@ -261,7 +261,7 @@ TEST(ParticleMathTest, ShadeEqualsTheOldCodeBitForBit) {
   EXPECT_GT(lit, 1000);  // snow lit by the lights, not only the sky
 }
 
-// ---- the realtime splat's projection before it moved to particle_math.h (branch gpu18), as
+// ---- the realtime splat's projection before it moved to particle_math.h, as
 // ParticleStreaks::BuildPixelHits ran it at main 58c0de3 ----
 
 struct OldProjection {

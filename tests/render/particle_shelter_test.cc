@@ -1,6 +1,5 @@
-// precipitation falls only where the sky is open above (render/shelter_map.h, issue 20 point
-// 4): rain under a roofed box is not drawn, rain in the open is, and sparks are not
-// sheltered.
+// precipitation falls only where the sky is open above (render/shelter_map.h): rain under a roofed
+// box is not drawn, rain in the open is, and sparks are not sheltered.
 
 #include <gtest/gtest.h>
 

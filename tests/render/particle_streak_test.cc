@@ -243,10 +243,9 @@ TEST(ParticleSceneTest, CameraRaysMeetEveryStreakTheyWouldWithoutTheViewCull) {
 // (ParticleStreaks::Build with kPixelCentres, the CPU backend's realtime streaks): every pixel
 // whose pixel-centre ray, cast with its own row's pose (Camera::GenerateRay), meets a streak's
 // capsule gets the nearest such streak (brute force over every streak: the same streak and t),
-// and no other pixel has one. before the boxes were widened for the rows' motion (main before
-// branch gpu25) the splat took every streak's box and row columns in the first row's pose only,
-// which leave out 206 of the 344 pixels met here (counted below, so the check can fail). a
-// still camera is checked too.
+// and no other pixel has one. a splat that takes every streak's box and row columns in the
+// first row's pose only, without widening the boxes for the rows' motion, would leave out 206 of
+// the 344 pixels met here (counted below, so the check can fail). a still camera is checked too.
 TEST(ParticleStreakTest, RollingShutterSplatFindsEveryStreakItsRowsMeet) {
   EffectsFrame fx;
   Lcg uniform{777};
@@ -269,7 +268,7 @@ TEST(ParticleStreakTest, RollingShutterSplatFindsEveryStreakItsRowsMeet) {
     ParticleStreaks streaks;
     streaks.Build(&fx, camera, 0.01, StreakRays::kPixelCentres);
     ASSERT_GT(streaks.size(), 100);
-    // the first row's pose only (X_WO: the splat's boxes and row columns before branch gpu25),
+    // the first row's pose only (X_WO: boxes and row columns not widened for the rows' motion),
     // to show that the check can fail: the pixels met by a streak outside its box there
     const Pose X_OW = camera.X_WO().inverse();
     const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> R_OW = X_OW.linear().cast<float>();

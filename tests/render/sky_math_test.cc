@@ -1,6 +1,6 @@
 // daylight by the numbers (render/sky_math.h): air mass, the sun's direct-normal and the clear
 // sky's diffuse illuminance against published clear-sky values, and the MJCF skybox lookup of
-// SkyModel::Background (issue 36, item 1).
+// SkyModel::Background.
 
 #include "penumbra/render/sky_math.h"
 

@@ -1,4 +1,4 @@
-// the sun-occluder map (render/sun_occluder_map.h, issue 37 point 3): it never skips a ray that
+// the sun-occluder map (render/sun_occluder_map.h): it never skips a ray that
 // would reach the sun (random rays against RayScene's exact occlusion test), it skips most sun
 // rays inside a roofed room, and the realtime tier renders the same image with it as without.
 

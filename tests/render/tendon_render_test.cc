@@ -1,4 +1,4 @@
-// spatial tendons (issue 17 point 3): a capsule of the tendon's width around each segment of its
+// spatial tendons: a capsule of the tendon's width around each segment of its
 // wrap-point path, in both tiers, moved by the snapshot's tendon paths.
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// issue 15 point 1, the last line of defence: RayScene never hands Embree a ray with a NaN,
+// the last line of defence: RayScene never hands Embree a ray with a NaN,
 // infinite or huge (> kMaxRayComponent) origin or direction. Embree 3 aborted the process on
 // such rays (`Assertion 'all(valid, ray.valid())' failed`); now they are misses, counted, and
 // the other rays of the same packet are traced as before.

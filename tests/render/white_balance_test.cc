@@ -102,7 +102,7 @@ TEST(WhiteBalanceTest, PlanckianWhite) {
 TEST(WhiteBalanceTest, NeutralGreyUnderDaylightIsNeutral) {
   const SceneDescription s = DaylightFloor(Eigen::Vector3f::Constant(0.5f));
   const ImageF radiance = RenderDaylightFloor(s);
-  // without white balance the sky's blue tints the grey (the cast).
+  // without white balance the sky's blue tints the grey (a colour cast).
   const double raw = ChromaOf(DevelopedMeanLinear(radiance, Eigen::Vector3f::Ones()));
   EXPECT_GT(raw, 0.02);
   for (WhiteBalance::Mode mode : {WhiteBalance::Mode::kAuto, WhiteBalance::Mode::kDaylight}) {

@@ -1,4 +1,4 @@
-// a run with a crowd (issue 39) recorded and replayed: the run log holds every agent's pose and
+// a run with a crowd recorded and replayed: the run log holds every agent's pose and
 // the crowd's decisions ("npc" events), and a kinematic replay (replay/log_source.h) poses the
 // agents exactly where the run had them.
 

@@ -1,4 +1,4 @@
-// issue 33: every length a run log declares is checked before it is added to, read or
+// every length a run log declares is checked before it is added to, read or
 // allocated: a chunk whose stored size is 2^64 - 4 (which wrapped the size + CRC sum and
 // crashed the chunk scan), a declared uncompressed size of 3.2 GB (which the reader allocated
 // before zstd found the frame short), a record count of 2^32 - 1 and a zero-encoded field of

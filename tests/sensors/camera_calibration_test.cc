@@ -1,7 +1,7 @@
 // lens distortion end to end: a checkerboard rendered through a Brown-Conrady camera, its corners
 // detected with OpenCV (findChessboardCorners + cornerSubPix) and cv::calibrateCamera must give
 // back the intrinsics and every distortion coefficient (k1 k2 p1 p2 k3) within 1 % relative, with
-// a reprojection rms below 0.5 px (issue 5 acceptance).
+// a reprojection rms below 0.5 px.
 //
 // what makes the coefficients identifiable from detected corners (~0.08 px rms detection error):
 // - the lens: a decentred wide-angle lens (90 deg horizontal field of view at 1280 x 960) whose

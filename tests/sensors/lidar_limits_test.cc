@@ -1,4 +1,4 @@
-// issue 15 point 8: a LiDAR pattern never grows past kMaxLidarBeamsPerScan. columns: 1e9 used to
+// a LiDAR pattern never grows past kMaxLidarBeamsPerScan. columns: 1e9 used to
 // end in a bare std::bad_alloc, and a tiny rate_hz made the presets' default column count
 // (beams per second / rate) overflow an int.
 

@@ -1,4 +1,4 @@
-// issue 17 point 6: a bare URDF (`penumbra run robot.urdf`) gets a ground plane, as a bare
+// a bare URDF (`penumbra run robot.urdf`) gets a ground plane, as a bare
 // model gets lights and a camera; URDF meshes MuJoCo cannot read are converted next
 // to the composed model.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// the NPC crowd in the bundled house and warehouse (issue 39): presets place crowds from the
+// the NPC crowd in the bundled house and warehouse: presets place crowds from the
 // generated environments' rooms and lanes on the walkable map, and the crowd model alone (no
 // physics, no rendering) keeps every agent on its region, apart from the others and clear of a
 // standing robot for 60 s; a session's crowd trajectories are bit-identical for a seed

@@ -1,4 +1,4 @@
-// issue 36, item 1: the bare-model default scene is lit by daylight by the numbers (the sun's
+// the bare-model default scene is lit by daylight by the numbers (the sun's
 // direct-normal and the sky's diffuse illuminance, render/sky_math.h), so a box's sun shadow on a
 // clear day is as dark as measured ratios say; and the model's MJCF skybox is the environment
 // the camera and a mirror floor see (as MuJoCo draws it).

@@ -1,4 +1,4 @@
-// issue 17 point 6 (floating base): a URDF's root link is welded to the world by MuJoCo's
+// floating base: a URDF's root link is welded to the world by MuJoCo's
 // importer; `floating_base: true` makes it a free body with the root link's inertial.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// issue 17 point 7 acceptance, through a world file only: a third-party-style quadruped with
+// a foreign robot through a world file only: a third-party-style quadruped with
 // position-servo actuators and no foot sites (the bundled quadruped with its motors replaced
 // by <position> servos and its foot sites and touch sensors removed) trots with trot_gait,
 // its feet added by the world file's `sites:` (at foot geoms, or on the calf bodies with an
@@ -209,7 +209,7 @@ std::string Go2StyleQuadruped() {
   return xml;
 }
 
-// issue 38: the documented Go2 walkthrough (sites at the foot geoms) on a model whose foot
+// the documented Go2 walkthrough (sites at the foot geoms) on a model whose foot
 // geoms get their pos from a default class: the sites land at the foot centres (0.213 m
 // below the knee axis, not on it) and trot_gait walks
 TEST(ForeignRobotWorld, Go2StyleFootGeomsPositionedByADefaultClassGiveFootSitesThatWalk) {
@@ -310,7 +310,7 @@ std::string InvertedKneeWorld(const std::string& signs) {
          legs + "      commands: [{t: 0, vx: 0.5}]\n";
 }
 
-// issue 38: a quadruped whose knee joints turn the other way than trot_gait's convention,
+// a quadruped whose knee joints turn the other way than trot_gait's convention,
 // run without `signs`, gets a warning at start-up naming the knee joints and the setting;
 // with the setting it names, no warning and it walks
 TEST(ForeignRobotWorld, InvertedKneeSignsAreWarnedAtStartWithTheSettingThatFixesThem) {

@@ -1,4 +1,4 @@
-// issue 17 point 7: the world file's `initial_keyframe` starts one model from one of its MJCF
+// the world file's `initial_keyframe` starts one model from one of its MJCF
 // keys; the other models keep their reference configuration.
 #include <gtest/gtest.h>
 

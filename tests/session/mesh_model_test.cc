@@ -1,4 +1,4 @@
-// issue 21 point 1 (acceptance): mesh files as world-file models, through the composed MJCF,
+// mesh files as world-file models, through the composed MJCF,
 // MuJoCo and both render tiers: a glTF's base colour texture lands where its texcoords say,
 // its normal map bends the shading as the tangent frame says, an OBJ in centimetres with y up
 // lands in metres with z up, and a malformed mesh fails naming the file.

@@ -1,4 +1,4 @@
-// the auto-framed camera of a bare model (issue 17 point 4).
+// the auto-framed camera of a bare model.
 
 #include "penumbra/session/scene_assembly.h"
 

@@ -1,4 +1,4 @@
-// issue 38: the first IMU sample of a robot standing under its controller read the free fall
+// the first IMU sample of a robot standing under its controller read the free fall
 // of a robot with ctrl 0 (about 0 instead of gravity): the first snapshot of a run now comes
 // after the controllers' first update (PhysicsSource, Simulation::RunDueControllers), and the
 // trajectory is the same bit for bit.

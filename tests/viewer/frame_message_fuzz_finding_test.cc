@@ -1,4 +1,4 @@
-// issue 33 (found by fuzz/viewer_messages_fuzz.cc): a frame message whose header is not JSON
+// found by fuzz/viewer_messages_fuzz.cc: a frame message whose header is not JSON
 // throws the documented penumbra::Error, not nlohmann's parse_error.
 
 #include <gtest/gtest.h>

@@ -346,11 +346,11 @@ def main():
                 refused = e.status_code
             check(refused == 403, f"a WebSocket with {what} gets 403 ({refused})")
 
-        # the adversity controls show the run's state (issue 38): the page renders the server's
+        # the adversity controls show the run's state: the page renders the server's
         # status message. choosing `major` moves every slider to major's values (from
         # worlds/adversity/presets.yaml, read here), the run applies it at its next step (the
         # server's log), and a second page sees the same; `none` moves them back
-        # the scene view starts on the robot (issue 38): the orbit camera's target is the
+        # the scene view starts on the robot: the orbit camera's target is the
         # robot's trunk as the run starts (paused: no state message yet), and the robot's own pixels show in the overview
         # (the overview rendered with and without the robot's bodies differs)
         check_scene_view_on_robot(driver, js, artefacts)

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""the viewer's contact-force signals against an independent computation (issue 38: the plot
-peaked at 1.96e5 N in the default world; that was the `major` preset's forklift, a kinematic
-NPC, pinning the robot, not a unit or sum error: docs/viewer.md "Plots").
+"""the viewer's contact-force signals against an independent computation (a plot
+peak of 1.96e5 N in the default world is the `major` preset's forklift, a kinematic NPC,
+pinning the robot, not a unit or sum error: docs/viewer.md "Plots").
 
 A world with a 2.5 kg crate as its robot and, in a static model, a 4 kg loose box and the
 floor, both resting on the floor (no camera): served by `penumbra view --running`, read by a raw

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""the crowd's walkable map in the live viewer (issue 39: "drawn in the viewer's scene view"),
+"""the crowd's walkable map in the live viewer's scene view,
 end to end with the real binary, a raw WebSocket client (python3-websocket) and a headless
 Chromium (Debian's chromium, chromium-driver, python3-selenium):
 

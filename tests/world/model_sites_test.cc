@@ -1,4 +1,4 @@
-// issue 17 point 7: robots and models take `sites:` (name + body or geom + pose) and
+// robots and models take `sites:` (name + body or geom + pose) and
 // `initial_keyframe:`; bad entries name the world file's line.
 #include <gtest/gtest.h>
 

@@ -817,7 +817,7 @@ TEST_F(WorldConfigTest, WorldForBareModelErrors) {
 namespace penumbra {
 namespace {
 
-// ---- issue 15 point 7: nothing in a world file is silently ignored, every error is placed ----
+// ---- nothing in a world file is silently ignored, every error is placed ----
 
 TEST_F(WorldConfigTest, SecondYamlDocumentIsAnError) {
   ExpectError("seed: 1\n---\nduration_sec: 5\n", 3, "", "a second YAML document");
@@ -833,7 +833,7 @@ TEST_F(WorldConfigTest, HugeValueIsEchoedShortened) {
   } catch (const ConfigError& e) {
     EXPECT_EQ(e.line(), 2);
     EXPECT_LT(std::string(e.what()).size(), 2000u);
-    // the name check quotes 16 characters (issue 33); other values are cut with "bytes elided"
+    // the name check quotes 16 characters; other values are cut with "bytes elided"
     EXPECT_NE(std::string(e.what()).find("a name of 10485761 characters ('nnnnnnnnnnnnnnnn...')"),
               std::string::npos)
         << e.what();

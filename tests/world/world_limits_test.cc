@@ -1,4 +1,4 @@
-// issue 15 (points 1, 2, 8): finite but absurd world-file values (poses of 1e19 m, intrinsics
+// finite but absurd world-file values (poses of 1e19 m, intrinsics
 // of 1e300 px, timesteps of 1e-300 s, durations of 1e308 s, LiDARs of 1e9 columns, plume
 // steps of 1e-9 s) are refused at load with the file, line, key and the accepted range
 // (scene/scene_limits.h, docs/world-file.md "Input limits").

@@ -1,4 +1,4 @@
-// issue 33 point 8: the nonsense that world files still got through silently. YAML tags
+// nonsense that world files must not get through silently. YAML tags
 // (`!foo 3`, `!!binary`) are refused instead of dropped; fields of view narrower than 0.1 deg
 // (fovy_deg 1e-300 gave fx = 2.75e303) and intrinsics far off the image are refused; names
 // longer than 64 characters are refused with the file and line (a 100 KB camera name used to

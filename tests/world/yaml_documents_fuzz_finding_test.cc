@@ -1,4 +1,4 @@
-// issue 33 (found by fuzz/world_fuzz.cc): the 7-byte world file ",sn\xd4 !:" made yaml-cpp 0.7's
+// found by fuzz/world_fuzz.cc: the 7-byte world file ",sn\xd4 !:" made yaml-cpp 0.7's
 // LoadAll return empty documents for ever (all memory taken within seconds); the documents are
 // now counted in a bounded loop. a second document with content is still refused with its line.
 

@@ -418,7 +418,7 @@ TEST(EmbreeRendererTest, ThreadCountDoesNotChangeTheImage) {
   EXPECT_EQ(a.ev100, b.ev100);
   EXPECT_EQ(a.rays, b.rays);
   // the image is not trivially uniform, and a different frame index changes nothing: the soft
-  // shadows have no per-frame noise (issue 36; they used to differ here).
+  // shadows have no per-frame noise.
   std::set<uint8_t> values(a.rgb.data.begin(), a.rgb.data.end());
   EXPECT_GT(values.size(), 50u);
   view.frame_index = 4;

@@ -1,4 +1,4 @@
-// the mirror layer's importance (render/cpu/mirror_layer.h, issue 37 point 2): mirrors with
+// the mirror layer's importance (render/cpu/mirror_layer.h): mirrors with
 // r >= kMirrorDenseReflectance are traced per pixel as before (bit-identical), weaker ones on a
 // grid of every 2nd or 4th pixel and interpolated (within r times the reflected contrast), with
 // depth and segmentation unchanged.
