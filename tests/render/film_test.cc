@@ -125,7 +125,7 @@ double HueDeg(const uint8_t* p) {
   return h < 0 ? h + 360 : h;
 }
 
-// issue 17: a per-channel curve turned a saturated orange yellow when over-exposed and red when
+// a per-channel curve would turn a saturated orange yellow when over-exposed and red when
 // dim. the filmic map keeps the hue of the material colour from 1/4 to 4x of the exposure at
 // which the linear colour itself is the exposed value.
 TEST(FilmTest, FilmicKeepsTheHueOfSaturatedColours) {
