@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# on a GPU machine: a realtime A/B in one call (docs/gpu-notes.md, "Realtime kernels: warp-shared
+# on a GPU machine: a realtime A/B in one call
+# (docs/journal/2026-11-26-gpu-speed.md, "Realtime kernels: warp-shared
 # penumbra rays, one surface evaluation"): unpacks scripts/gpu/pack.sh's tarball, runs a baseline
 # render_cuda_bench (xz-compressed, another commit's, run with this pack's libraries) and this
 # pack's, interleaved (--realtime, default and house at 640x480), the realtime `gpu` tests, and

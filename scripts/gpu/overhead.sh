@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # on a GPU machine: what Render() spends outside its kernels, old against new in one call
-# (docs/gpu-notes.md, "`Render()`'s host overhead (branch gpu13)"): unpacks scripts/gpu/pack.sh's
+# (docs/journal/2026-11-26-gpu-speed.md, "`Render()`'s host overhead"): unpacks pack.sh's
 # tarball, names the card, runs a baseline render_cuda_bench (xz-compressed, another commit's,
 # run with this pack's libraries) and this pack's, interleaved base, new, base, new, ...: the
 # single-camera table (`--frames 100`, default and house, 640x480 and 128x128) REPEATS times and

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # on a GPU machine, in an unpacked pack (scripts/gpu/pack.sh) or a build folder: prints the
 # parity table of the CUDA backend against the CPU backend (issue 35, item 7; docs/gpu.md
-# "Parity") for the default, house, warehouse and outdoor worlds and every worlds/effects/*.yaml:
+# "Measured") for the default, house, warehouse and outdoor worlds and every worlds/effects/*.yaml:
 # the first camera at 320x240 after 1 s, depth within 1 mm %, segmentation equal %, same-depth
 # ties, whether the frame with the world's effects is on the GPU (every effect since branch
 # gpu12: lighting effects, particles, homogeneous and grid media, particles seen through media),

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# on a GPU machine: the realtime tier's speed table in one go (docs/gpu-notes.md, "Realtime speed on
+# on a GPU machine: the realtime tier's speed table in one go
+# (docs/journal/2026-11-26-gpu-speed.md, "Realtime speed on
 # an H100"): unpacks scripts/gpu/pack.sh's tarball, names the card, and runs
 # render_cuda_bench --realtime (Render() stages, kernel ablations, CPU backend; 3 repeats at
 # 640x480, one at 128x128), the single-camera table of this build and, if given, of a baseline

@@ -17,7 +17,8 @@
 //    the grids (MediaScene::Transmittance); MediaTrackOf: spectral delta tracking of a free
 //    flight (MediaScene::Track). models and sources: render/media_scene.h.
 // operation order: the Eigen code's (per coefficient, its 3x3 product as GridToFrame, its
-// maxCoeff as max(max(x, y), z); docs/gpu-notes.md, "Media in the pathtraced tier on the GPU"),
+// maxCoeff as max(max(x, y), z);
+// docs/journal/2026-11-27-gpu-pathtraced.md, "Media in the pathtraced tier"),
 // and tests/render/media_scene_math_test.cc checks the functions bit for bit against Eigen.
 // random numbers: the caller's Rng, drawn in the CPU's order.
 

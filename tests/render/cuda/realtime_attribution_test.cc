@@ -1,5 +1,6 @@
 // where the CUDA realtime rgb path (run on the CPU: RenderRealtimeOnHost) differs from the CPU
-// backend, by feature (docs/gpu-notes.md, "Where the realtime rgb differs"). for the bundled
+// backend, by feature
+// (docs/journal/2026-11-26-gpu-effects.md, "Where the realtime rgb differs"). for the bundled
 // default, house, warehouse and outdoor worlds and effects/walkers.yaml (whose frames have no
 // effects: the GPU renders them; its rover's materials have mirror layers), the first camera after
 // 1 s is rendered by the CPU backend with every part on, with the mirror layer off and with shadows

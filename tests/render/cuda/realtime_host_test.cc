@@ -60,7 +60,8 @@ TEST_P(RealtimeHostPath, MatchesCpuBackend) {
       "%s 160x120: rgb PSNR %.2f dB, ev100 cpu %.4f host-gpu-path %.4f, depth > 1 mm on "
       "%.4f %% of pixels\n",
       GetParam().c_str(), psnr, want.ev100, got.ev100, 100 * depth_bad);
-  // measured with the mirror layer on the GPU path (docs/gpu-notes.md, "Where the realtime rgb
+  // measured with the mirror layer on the GPU path
+  // (docs/journal/2026-11-26-gpu-effects.md, "Where the realtime rgb
   // differs"): default 95.7 dB, house 81.4, warehouse 61.6, outdoor 66.8, walkers 92.7 (48.8
   // and 29.8 without it).
   EXPECT_GE(psnr, 40.0);

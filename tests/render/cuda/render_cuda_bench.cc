@@ -1263,7 +1263,8 @@ int Main(int argc, char** argv) {
               "(the last of the timed frames; RealtimeFrameData::Prepare, media volumes included)",
               name, size, static_cast<cuda::CudaRenderer*>(gpu.get())->last_prepare_ms()));
       }
-      // the media volumes' build over Embree and over the GPU's RayQuery (docs/gpu-notes.md,
+      // the media volumes' build over Embree and over the GPU's RayQuery
+      // (docs/journal/2026-11-26-gpu-effects.md,
       // "Homogeneous media: the shared part")
       if (dev.available && with_fx && (!fx->homogeneous_media.empty() || !fx->grid_media.empty()) &&
           w == 640) {

@@ -6,7 +6,8 @@
 // texture on it (MuJoCo's builtin, 64 x 64 texels) with a checker normal map (texture
 // "checker/normal", the material's PBR map by name: flat and tilted squares, bent in the
 // texcoords' tangent frame), a box wrapped in a cube texture, a floor, a lamp, a gradient skybox
-// (the background of escaping rays) and a camera that sees all of them (docs/gpu-notes.md,
+// (the background of escaping rays) and a camera that sees all of them
+// (docs/journal/2026-11-26-gpu-effects.md,
 // "Textured meshes, smooth normals, cube textures and skyboxes on the GPU").
 
 #include <cmath>

@@ -37,7 +37,7 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, const RenderSettings& 
   // the statics' maps trace on the host (MakeRenderer's renderer through Embree, as the CPU
   // backend's): their rays on the GPU made the first frame shorter, but a second device copy of
   // the geometry made every later frame's kernels 2-7 % slower ("A new renderer's first frame"
-  // in docs/gpu.md)
+  // in docs/journal/2026-11-26-gpu-speed.md)
   realtime_ = std::make_unique<RealtimeFrameData>(
       scene_, settings, statics_query ? std::move(statics_query) : BvhRayQueryFactory(pool_.get()));
   device_realtime_ = std::make_unique<DeviceRealtime>();
