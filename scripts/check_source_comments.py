@@ -8,7 +8,7 @@ Scanned: the files git tracks under src, tests, bench, fuzz, tools, python, scri
 web and train, and every CMakeLists.txt: C, C++ and CUDA (// and /* */ comments), JavaScript
 (the same), Python (# comments and string statements: docstrings), CMake and shell (#
 comments). Only comment text is read, never code or string literals, and a comment may wrap a
-reference over two lines (`(branch` / `gpu29)`). Not flagged: links to other projects' issues
+reference over two lines (`(branch` / `gpuN)`). Not flagged: links to other projects' issues
 (`.../issues/123`, or `issue N` after "upstream", "github", "gitlab" or a URL on the same
 line) and the verb (`may issue 2 requests`: `issue` after to, can, may, will, ...).
 
@@ -40,9 +40,9 @@ PY_EXTS = (".py",)
 HASH_EXTS = (".sh", ".bash", ".cmake")
 HEX = string.hexdigits
 
-# a branch name of the GPU work (gpu8, gpu29), with or without the word "branch" before it
+# a branch name of the GPU work (gpu and a number), with or without the word "branch" before it
 BRANCH_RE = re.compile(r"\b(?:branch(?:es)?\s+)?gpu\d+\b", re.IGNORECASE)
-# this project's issue numbers: issue 36, issues 19 and 22, issue #5
+# this project's issue numbers: issue N, issues N and M, issue #N
 ISSUE_RE = re.compile(r"\bissues?\s*#?\d+\b", re.IGNORECASE)
 # before one of these, `issue N` is the verb (`may issue 2 requests`)
 VERB_CONTEXT = {"to", "can", "cannot", "may", "might", "will", "would", "should", "could",
