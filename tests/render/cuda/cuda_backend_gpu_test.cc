@@ -8,9 +8,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
-#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -183,8 +183,7 @@ TEST(CudaBackend, SharedExponentialGivesTheHostsBits) {
   for (int i = 0; i <= n; ++i) x.push_back(-104.0f + (88.7f + 104.0f) * static_cast<float>(i) / n);
   for (float t = -20.0f; t <= 0.0f; t += 1.0f / 4096) x.push_back(t);
   const float inf = std::numeric_limits<float>::infinity();
-  for (float t : {0.0f, -0.0f, 1e-30f, 88.72f, 88.75f, -100.0f, -104.5f, inf, -inf})
-    x.push_back(t);
+  for (float t : {0.0f, -0.0f, 1e-30f, 88.72f, 88.75f, -100.0f, -104.5f, inf, -inf}) x.push_back(t);
   std::vector<float> device(x.size());
   cuda::ExpRnOnDevice(x.data(), device.data(), static_cast<int64_t>(x.size()));
   int differ = 0;
@@ -197,13 +196,14 @@ TEST(CudaBackend, SharedExponentialGivesTheHostsBits) {
   EXPECT_EQ(differ, 0) << "of " << x.size() << " arguments";
 }
 
-TEST(CudaBackend, PrimaryCopyVariantsWriteTheSameBytes) {
+// the ground-truth images copied back in one band (97x61) and in bands (320x240), into new and
+// reused images: every render the same bytes, most pixels hit.
+TEST(CudaBackend, PrimaryCopiesWriteTheSameBytesEveryFrame) {
   PB_REQUIRE_CUDA_DEVICE();
   const std::unique_ptr<Session> session = LoadBundled("house.yaml");
   RenderSettings settings;
   settings.backend = RenderSettings::Backend::kCuda;
   const std::unique_ptr<Renderer> gpu = MakeRenderer(session->scene(), settings);
-  auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
   const WorldSnapshot snap = session->sim().Snapshot();
   CameraView view;
   view.X_WO = CameraPoseInWorld(session->scene().cameras.front(), snap);
@@ -217,25 +217,18 @@ TEST(CudaBackend, PrimaryCopyVariantsWriteTheSameBytes) {
            a.range_m.data == b.range_m.data && a.normal_O.data == b.normal_O.data &&
            a.body_id.data == b.body_id.data && a.semantic_class.data == b.semantic_class.data;
   };
-  std::vector<cuda::PrimaryCopyOptions> variants(5);
-  variants[1].bands = 1;
-  variants[2].bands = 7;
-  variants[3].parallel_copies = false;
-  variants[4].pinned = false;
   for (const auto& [w, h] : {std::pair{97, 61}, std::pair{320, 240}}) {
     view.intrinsics = CameraIntrinsics::FromFovy(w, h, 60);
     RenderedFrame want;
-    g->device().set_primary_options(variants[4]);
     gpu->Render(snap, view, &want);
     ASSERT_EQ(want.normal_O.data.size(), static_cast<size_t>(3 * w * h));
     int hits = 0;
     for (float d : want.depth_m.data) hits += d > 0;
     EXPECT_GT(hits, w * h / 2);
-    RenderedFrame reused;  // one frame through every variant (its images reused, then resized)
-    for (size_t v = 0; v < variants.size(); ++v) {
-      SCOPED_TRACE("variant " + std::to_string(v) + ", " + std::to_string(w) + "x" +
+    RenderedFrame reused;  // one frame rendered again (its images reused, then resized)
+    for (int v = 0; v < 2; ++v) {
+      SCOPED_TRACE("render " + std::to_string(v) + ", " + std::to_string(w) + "x" +
                    std::to_string(h));
-      g->device().set_primary_options(variants[v]);
       RenderedFrame fresh;
       gpu->Render(snap, view, &fresh);
       gpu->Render(snap, view, &reused);

@@ -10,24 +10,19 @@
 //     (CUDA events, no copies);
 //   - cpu depth+seg and cpu rgb+depth (realtime tier), all cores;
 //   - for a world with effects at 1 s (e.g. worlds/effects/flashlight.yaml), rgb+depth under
-//     them, cuda Render() (on the GPU for every effect since branch gpu12) and cpu Render();
-//     with particles also cuda Render() with the streaks splatted on the host (as before branch
-//     gpu18: RealtimeFrameData::set_device_streaks(false)), then twice the device splat with its
-//     streaks made before the kernels (as before branch gpu23: CudaRenderer::set_late_streaks
-//     (false)) and late (the default: while the GPU shades), the host's preparation of each,
-//     and the FNV-1a hashes of the rgb, depth and radiance and the EV100 of a late-streaks frame
-//     and of one with the streaks before the kernels (whether they are bit-identical); then
-//     a rolling-shutter camera turning during the readout (realtime_parity::AddRollingShutter)
-//     with the device splat and the host splat, and the pixels each keys; then the drops
-//     culled on the device (the default since branch gpu27) and on the host
-//     (CudaRenderer::set_device_culling(false)), late streaks, twice interleaved, with the
-//     host's time making the streaks of each and the hashes of a host-culled frame;
+//     them, cuda Render() and cpu Render(); with particles also cuda Render() with the streaks
+//     splatted on the host (RealtimeFrameData::set_device_streaks(false)), the host's
+//     preparation of each, the drops culled on the device with late streaks twice (the host's
+//     time making the streaks), where one rain frame's time goes, a rolling-shutter camera
+//     turning during the readout (realtime_parity::AddRollingShutter) with the device splat and
+//     the host splat and the pixels each keys, and the FNV-1a hashes of the rgb, depth and
+//     radiance and the EV100 of a frame;
 //     with media
 //     (homogeneous or grids), the time of their
 //     realtime volumes' build (RealtimeMedia::Build at 640x480) with Embree's shadow rays, with
 //     CudaRayQuery's and with BvhRayQuery's (the host traversal), and the CUDA backend's host
 //     preparation of such a frame (CudaRenderer::last_prepare_ms, the build included);
-//   - with --realtime, the FNV-1a hashes of the default options' rgb and depth (to compare
+//   - with --realtime, the FNV-1a hashes of the rgb and depth (to compare
 //     builds: a change of the traversal or the kernels that keeps the images keeps them);
 // and the BVH build time. prints one markdown table.
 // --batch N[,N...] [--size WxH] [--sessions S]: batch rendering instead (cuda_batch_bench.h):
@@ -51,21 +46,14 @@
 // new arrays every frame and go to the device every frame: the same columns and the bytes
 // uploaded a frame.
 // --realtime [--size WxH]: the realtime tier's rgb+depth at WxH (default 640x480) in detail:
-// Render() with the sky terms on the device (default), on the host (the geometry's round trip
-// in 4 bands of rows and in 1; RealtimeKernelOptions::device_sky), with pageable copies, with
-// the radiance in 1 or 4 bands, with the exposure's round trip through the host
-// (device_exposure off) and with the posed geoms and lights uploaded every frame
-// (upload_changed_only off), the host's copies on one thread (parallel_copies off) or in other
-// chunks (copy_chunk_kib), and without the radiance (CudaRenderer::set_radiance_output), and where
-// its time goes (RealtimeStageTimes; the host's preparation before the kernels,
-// CudaRenderer::last_prepare_ms), the kernels alone as they run by default and with each speed-up
-// of RealtimeKernelOptions turned off (ablations; each variant's rgb compared with the default's),
-// the CPU backend, the FNV-1a hashes of the rgb, depth and radiance and the EV100, and how often
-// the device's exposure differed from the host's (RealtimeExposureChecks); then a table of where
-// Render()'s time goes (the host's preparation, the launches, the kernels' and the copies' end
-// by CUDA events, the host's work after the last transfer; also into a new RenderedFrame every
-// frame, as the camera sink renders) and the same for depth+seg with each of RenderPrimary's
-// ways of copying back (cuda::PrimaryCopyOptions: bands, one thread, pageable).
+// Render() into the same RenderedFrame, into a new one every frame (as the camera sink renders)
+// and without the radiance (CudaRenderer::set_radiance_output), and where its time goes
+// (RealtimeStageTimes; the host's preparation before the kernels, CudaRenderer::last_prepare_ms),
+// the kernels alone, the CPU backend, the FNV-1a hashes of the rgb, depth and radiance and the
+// EV100, and how often the device's exposure differed from the host's (RealtimeExposureChecks);
+// then a table of where Render()'s time goes (the host's preparation, the launches, the
+// kernels' and the copies' end by CUDA events, the host's work after the last transfer) and the
+// same for depth+seg.
 // --parity [--size WxH]: the parity table against the CPU backend (cuda_parity.h, default
 // 320x240; scripts/gpu/parity.sh).
 // --pathtraced [--size WxH] [--spp N]: the pathtraced tier (default 320x240, 64 samples per
@@ -339,14 +327,14 @@ int MediaMain(const std::vector<std::string>& worlds, int width, int height, int
   return 0;
 }
 
-// --realtime: the realtime tier's Render() stages and kernel ablations (file comment)
+// --realtime: the realtime tier's Render() stages and kernels (file comment)
 int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, int frames) {
   fmt::print(
       "\n| world | size | variant | frames/s | ms/frame | geometry ms | sky ms | shade ms "
       "| film+copies ms (copies after the row sums) | rgb as default "
       "|\n|---|---|---|---:|---:|---:|---:|---:|---:|---|\n");
-  // where Render()'s host time goes (RealtimeStageTimes, CudaRenderer::last_prepare_ms;
-  // device_sky with device_exposure): printed after the variants' table
+  // where Render()'s host time goes (RealtimeStageTimes, CudaRenderer::last_prepare_ms):
+  // printed after the variants' table
   std::vector<std::string> host_rows;
   for (const std::string& file : worlds) {
     const BenchWorld world = LoadBenchWorld(file);
@@ -366,77 +354,21 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     const std::unique_ptr<Renderer> gpu = MakeRenderer(scene, gpu_settings);
     auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
     cuda::DeviceRealtime& rt = g->device_realtime();
-    const cuda::RealtimeKernelOptions fast = rt.options();
     RenderedFrame want, again;
     gpu->Render(snap, view, &want);
     gpu->Render(snap, view, &again);
     const bool repeatable = want.rgb.data == again.rgb.data &&
                             want.radiance.data == again.radiance.data &&
                             want.depth_m.data == again.depth_m.data;
-    // Render(): sky terms on the device with pinned copies (default), on the host in 4 bands
-    // and in 1 band of rows (the round trip the device path replaced), pageable copies
-    std::vector<cuda::RealtimeKernelOptions> copy_variants = {fast};
-    for (const int bands : {4, 1}) {
-      cuda::RealtimeKernelOptions o = fast;
-      o.device_sky = false;
-      o.sky_bands = bands;
-      copy_variants.push_back(o);
-    }
-    copy_variants.push_back(fast);
-    copy_variants.back().pinned = false;
-    for (const int bands : {1, 4}) {
-      copy_variants.push_back(fast);
-      copy_variants.back().output_bands = bands;
-    }
-    // the exposure's round trip through the host, the posed geoms and lights uploaded every
-    // frame, both (as before branch gpu7)
-    copy_variants.push_back(fast);
-    copy_variants.back().device_exposure = false;
-    copy_variants.push_back(fast);
-    copy_variants.back().upload_changed_only = false;
-    copy_variants.push_back(fast);
-    copy_variants.back().device_exposure = copy_variants.back().upload_changed_only = false;
-    copy_variants.push_back(fast);
-    copy_variants.back().parallel_copies = false;
-    for (const int kib : {64, 1024}) {
-      copy_variants.push_back(fast);
-      copy_variants.back().copy_chunk_kib = kib;
-    }
-    copy_variants.push_back(fast);
-    copy_variants.back().copy_chunk_kib = 64;
-    copy_variants.back().output_bands = 4;
-    // the host's copies over the pool whatever their size (before branch gpu13)
-    copy_variants.push_back(fast);
-    copy_variants.back().serial_copy_kib = 0;
-    // the mirror layer on the frame's stream, the resolve and blend apart, both (before branch
-    // gpu19)
-    copy_variants.push_back(fast);
-    copy_variants.back().mirror_stream = false;
-    copy_variants.push_back(fast);
-    copy_variants.back().fuse_resolve = false;
-    copy_variants.push_back(fast);
-    copy_variants.back().mirror_stream = copy_variants.back().fuse_resolve = false;
-    // the shading's light terms in local memory (before branch gpu20)
-    copy_variants.push_back(fast);
-    copy_variants.back().shared_light_terms = false;
-    // the shadow rays through the queue whatever the frame's size, never (branch gpu22)
-    copy_variants.push_back(fast);
-    copy_variants.back().queue_shadow_rays_always = true;
-    copy_variants.push_back(fast);
-    copy_variants.back().queue_shadow_rays = false;
-    // second to last: the default into a new RenderedFrame every frame (as the camera sink's
-    // CameraImages: the images allocated, zero-filled and first touched each frame); last: the
-    // default without the radiance (CudaRenderer::set_radiance_output)
-    copy_variants.push_back(fast);
-    copy_variants.push_back(fast);
+    // Render(): into the same RenderedFrame every frame; into a new one every frame (as the
+    // camera sink's CameraImages: the images allocated, zero-filled and first touched each
+    // frame); without the radiance (CudaRenderer::set_radiance_output)
+    const char* const render_variants[] = {"", ", a new RenderedFrame every frame",
+                                           ", no radiance asked for"};
     double prepare_ms = 0;  // the default's host preparation before the kernels
-    for (size_t v = 0; v < copy_variants.size(); ++v) {
-      const cuda::RealtimeKernelOptions& o = copy_variants[v];
-      const bool pinned = o.pinned;
-      const bool no_radiance = v + 1 == copy_variants.size();
-      const bool fresh = v + 2 == copy_variants.size();
+    for (int v = 0; v < 3; ++v) {
+      const bool fresh = v == 1, no_radiance = v == 2;
       g->set_radiance_output(!no_radiance);
-      rt.set_options(o);
       RenderedFrame f;
       for (int i = 0; i < 3; ++i) gpu->Render(snap, view, &f);
       cuda::RealtimeStageTimes sum;
@@ -455,75 +387,35 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
       const double s = std::chrono::duration<double>(Clock::now() - t0).count() / frames;
       const bool same = f.rgb.data == want.rgb.data;
       if (v == 0) prepare_ms = prepare / frames;
-      std::string extra;
-      if (!o.device_exposure) extra += ", host exposure";
-      if (!o.upload_changed_only) extra += ", uploads every frame";
-      if (!o.parallel_copies) extra += ", host copies on one thread";
-      if (o.copy_chunk_kib != fast.copy_chunk_kib)
-        extra += fmt::format(", host copies in {} KiB chunks", o.copy_chunk_kib);
-      if (o.serial_copy_kib != fast.serial_copy_kib)
-        extra += fmt::format(", host copies over the pool above {} KiB", o.serial_copy_kib);
-      if (!o.mirror_stream) extra += ", mirror layer on the frame's stream";
-      if (!o.fuse_resolve) extra += ", resolve and mirror blend apart";
-      if (!o.shared_light_terms) extra += ", light terms in local memory";
-      if (!o.queue_shadow_rays) extra += ", shadow rays never queued";
-      if (o.queue_shadow_rays && o.queue_shadow_rays_always) extra += ", shadow rays always queued";
-      if (no_radiance) extra += ", no radiance asked for";
-      if (fresh) extra += ", a new RenderedFrame every frame";
+      const std::string extra = render_variants[v];
       fmt::print(
-          "| {} | {} | cuda Render(), {} copies{} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | "
-          "{:.3f} | {:.3f} ({:.3f}) | {} |\n",
-          name, size,
-          fmt::format(
-              "{}, {}", pinned ? "pinned" : "pageable",
-              o.device_sky
-                  ? (pinned ? fmt::format("device sky, radiance in {} band{}", o.output_bands,
-                                          o.output_bands == 1 ? "" : "s")
-                            : std::string("device sky"))
-                  : fmt::format("host sky in {} band{}", o.sky_bands, o.sky_bands == 1 ? "" : "s")),
-          extra, 1 / s, 1e3 * s, sum.geometry / frames, sum.sky / frames, sum.shade / frames,
-          sum.film / frames, sum.outputs / frames, same ? "yes" : "NO");
-      if (o.device_sky && o.device_exposure && o.pinned) {
-        const double wall = 1e3 * s, inside = total / frames;
-        host_rows.push_back(fmt::format(
-            "| {} | {} | {}{} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | "
-            "{:.3f} |",
-            name, size,
-            fmt::format("radiance in {} band{}", o.output_bands, o.output_bands == 1 ? "" : "s"),
-            extra, wall, prepare / frames, wall - inside, sum.launched / frames,
-            sum.kernels_end / frames, sum.copies_end / frames, inside - sum.copies_end / frames,
-            sum.outputs / frames));
-      }
+          "| {} | {} | cuda Render(){} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | "
+          "{:.3f} ({:.3f}) | {} |\n",
+          name, size, extra, 1 / s, 1e3 * s, sum.geometry / frames, sum.sky / frames,
+          sum.shade / frames, sum.film / frames, sum.outputs / frames, same ? "yes" : "NO");
+      const double wall = 1e3 * s, inside = total / frames;
+      host_rows.push_back(fmt::format(
+          "| {} | {} | Render(){} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | "
+          "{:.3f} |",
+          name, size, extra, wall, prepare / frames, wall - inside, sum.launched / frames,
+          sum.kernels_end / frames, sum.copies_end / frames, inside - sum.copies_end / frames,
+          sum.outputs / frames));
     }
     g->set_radiance_output(true);
     fmt::print(
         "| {} | {} | cuda Render(), host preparation before the kernels (default) | | {:.3f} "
         "| | | | | |\n",
         name, size, prepare_ms);
-    // depth + segmentation (the ground-truth kernel): its copies as PrimaryCopyOptions says
+    // depth + segmentation (the ground-truth kernel), into the same RenderedFrame and into a
+    // new one every frame
     {
       CameraView truth = view;
       truth.outputs = CameraOutputs::None();
       truth.outputs[ImageKind::kDepth] = truth.outputs[ImageKind::kSegmentation] = true;
-      const cuda::PrimaryCopyOptions primary = g->device().primary_options();
-      std::vector<std::pair<std::string, cuda::PrimaryCopyOptions>> pv;
-      pv.push_back({fmt::format("pinned, {} bands (default)", primary.bands), primary});
-      for (const int bands : {1, 2, 8}) {
-        cuda::PrimaryCopyOptions q = primary;
-        q.bands = bands;
-        pv.push_back({fmt::format("pinned, {} band{}", bands, bands == 1 ? "" : "s"), q});
-      }
-      pv.push_back({"pinned, host copies on one thread", primary});
-      pv.back().second.parallel_copies = false;
-      pv.push_back({"pinned, host copies over the pool at any size", primary});
-      pv.back().second.serial_copy_kib = 0;
-      pv.push_back({"pageable copies (as before branch gpu13)", primary});
-      pv.back().second.pinned = false;
-      pv.push_back({"pinned (default), a new RenderedFrame every frame", primary});
+      const std::vector<std::string> pv = {"same frame", "a new RenderedFrame every frame"};
       RenderedFrame ref;
       gpu->Render(snap, truth, &ref);
-      for (const auto& [what, q] : pv) {
-        g->device().set_primary_options(q);
+      for (const std::string& what : pv) {
         RenderedFrame f;
         for (int i = 0; i < 3; ++i) gpu->Render(snap, truth, &f);
         cuda::PrimaryTimes sum;
@@ -543,109 +435,13 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
             name, size, what, 1e3 * s, 1e3 * s - sum.total / pf, sum.kernel / pf, sum.copies / pf,
             (sum.total - sum.copies) / pf, same ? "same bytes" : "DIFFER"));
       }
-      g->device().set_primary_options(primary);
     }
-    rt.set_options(fast);
-    // the kernels alone: the default, each speed-up off, all off
-    struct Variant {
-      const char* what;
-      cuda::RealtimeKernelOptions o;
-    };
-    std::vector<Variant> variants = {{"kernels, all speed-ups", fast}};
-    cuda::RealtimeKernelOptions o = fast;
-    o.reuse_hit = false;
-    variants.push_back({"kernels, primary ray traced twice", o});
-    o = fast;
-    o.min_blocks = 1;
-    variants.push_back({"kernels, shading registers uncapped", o});
-    o.min_blocks = 6;
-    variants.push_back({"kernels, shading <= 85 registers", o});
-    o = fast;
-    o.geometry_min_blocks = 1;
-    variants.push_back({"kernels, geometry registers uncapped", o});
-    o = fast;
-    o.queue_penumbra = false;
-    variants.push_back({"kernels, penumbra rays per warp (no queue)", o});
-    o.warp_penumbra = false;
-    variants.push_back({"kernels, penumbra rays per pixel", o});
-    o = fast;
-    o.reuse_surface = false;
-    variants.push_back({"kernels, surface evaluated twice", o});
-    o = fast;
-    o.mirror_stream = false;
-    variants.push_back({"kernels, mirror layer on the frame's stream", o});
-    o = fast;
-    o.fuse_resolve = false;
-    variants.push_back({"kernels, resolve and mirror blend apart", o});
-    o.mirror_stream = false;
-    variants.push_back({"kernels, both of those off", o});
-    o = fast;
-    o.mirror_low_priority = false;
-    variants.push_back({"kernels, mirror layer's stream of the frame's priority", o});
-    o = fast;
-    o.shared_light_terms = false;
-    variants.push_back({"kernels, shading's light terms in local memory", o});
-    o.queue_shadow_rays_always = true;
-    variants.push_back({"kernels, light terms in local memory, shadow rays always queued", o});
-    o = fast;
-    o.queue_shadow_rays_always = true;
-    variants.push_back({"kernels, shadow rays always queued (three passes)", o});
-    o = fast;
-    o.queue_shadow_rays = false;
-    variants.push_back({"kernels, shadow rays never queued (in the shading kernel)", o});
-    o = fast;
-    o.penumbra_chunk_rays = 4;
-    variants.push_back({"kernels, penumbra queue in chunks of 4 rays", o});
-    o.penumbra_chunk_rays = 2;
-    variants.push_back({"kernels, penumbra queue in chunks of 2 rays", o});
-    o = fast;
-    o.tile_visibility = false;
-    variants.push_back({"kernels, visibility fraction and resolve apart (no tiles)", o});
-    o = fast;
-    o.tile_penumbra = false;
-    variants.push_back({"kernels, penumbra rays in 16x8 blocks (no tiles)", o});
-    o.tile_visibility = false;
-    variants.push_back({"kernels, no shadow-tile kernels (both off)", o});
-    o = fast;
-    o.packed_window_counts = false;
-    variants.push_back({"kernels, window counts packed at each tap (tile kernel)", o});
-    o = fast;
-    o.window_verdict_rows = false;
-    variants.push_back({"kernels, penumbra tiles' window verdicts bit by bit (no bit rows)", o});
-    o.staged_window = false;
-    variants.push_back({"kernels, penumbra tiles' windows from global memory (no staging)", o});
-    o = fast;
-    o.occlusion_tlas = false;
-    variants.push_back({"kernels, occlusion rays through every instance (no top level)", o});
-    o = fast;
-    o.closest_tlas = false;
-    variants.push_back({"kernels, closest hits through every instance (no top level)", o});
-    o.occlusion_tlas = false;
-    variants.push_back({"kernels, no top level (closest and occlusion)", o});
-
-    o = fast;
-    o.rows_per_warp = false;
-    variants.push_back({"kernels, row sums per thread", o});
-    o.reuse_hit = false;
-    o.reuse_surface = false;
-    o.warp_penumbra = false;
-    o.queue_penumbra = false;
-    o.mirror_stream = o.fuse_resolve = o.shared_light_terms = o.queue_shadow_rays = false;
-    o.tile_visibility = o.tile_penumbra = o.occlusion_tlas = o.closest_tlas = false;
-    o.min_blocks = o.geometry_min_blocks = 1;
-    variants.push_back({"kernels, all speed-ups off", o});
-    const int kernel_frames = std::max(10, frames * 4);
-    for (const Variant& var : variants) {
-      // the variant's image: one Render with it
-      rt.set_options(var.o);
-      RenderedFrame f;
-      gpu->Render(snap, view, &f);
-      const double ms = rt.TimeKernels(&g->device(), kernel_frames, var.o);
-      fmt::print("| {} | {} | {} | {:.0f} | {:.3f} | | | | | {} |\n", name, size, var.what,
-                 1e3 / ms, ms, f.rgb.data == want.rgb.data ? "yes" : "NO");
-    }
-    rt.set_options(fast);
+    // the kernels alone
     gpu->Render(snap, view, &want);
+    const int kernel_frames = std::max(10, frames * 4);
+    const double kernel_ms = rt.TimeKernels(&g->device(), kernel_frames);
+    fmt::print("| {} | {} | kernels | {:.0f} | {:.3f} | | | | | |\n", name, size, 1e3 / kernel_ms,
+               kernel_ms);
     RenderSettings cpu_settings;
     cpu_settings.backend = RenderSettings::Backend::kEmbree;
     cpu_settings.threads = 0;
@@ -1067,7 +863,7 @@ int Main(int argc, char** argv) {
         rows.push_back({name, size, fx_outputs, "cuda", "Render()",
                         1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
         if (!fx->particles.empty()) {
-          // the particle streaks splatted on the device (the default, branch gpu18) against the
+          // the particle streaks splatted on the device (the default) against the
           // host splat of before (RealtimeFrameData::set_device_streaks(false)), then the device
           // again (drift)
           auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
@@ -1081,64 +877,26 @@ int Main(int argc, char** argv) {
           g->realtime_frame().set_device_streaks(true);
           rows.push_back({name, size, "rgb+depth realtime + effects, streaks splatted on the host",
                           "cuda", "Render()", host_fps});
-          // the device splat's streaks made before any device work (as before branch gpu23:
-          // CudaRenderer::set_late_streaks(false)) against late (the default: the drops culled
-          // while the GPU shades), interleaved, and the images of both
-          const auto serial_late = [&](const char* again) {
-            g->set_late_streaks(false);
-            rows.push_back({name, size,
-                            fmt::format("rgb+depth realtime + effects (on GPU), streaks made "
-                                        "before the kernels{}",
-                                        again),
-                            "cuda", "Render()",
-                            1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
-            g->set_late_streaks(true);
-            rows.push_back(
-                {name, size,
-                 fmt::format("rgb+depth realtime + effects (on GPU), late streaks{}", again),
-                 "cuda", "Render()", 1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
-          };
-          serial_late("");
-          const double prep_serial = [&] {
-            g->set_late_streaks(false);
-            RenderedFrame f;
-            gpu->Render(snap, fx.get(), rgb, &f);
-            g->set_late_streaks(true);
-            return g->last_prepare_ms();
-          }();
-          serial_late(", again");
-          // the drops culled on the device (the default, branch gpu27) against the host's
-          // culling (CudaRenderer::set_device_culling(false)), late streaks, interleaved twice;
-          // the host's time making the streaks of each (last_late_streaks_ms)
-          double cull_host_ms[2] = {0, 0}, cull_device_ms[2] = {0, 0};
-          double cull_run_ms[2] = {0, 0}, cull_stage_ms[2] = {0, 0};
-          // one timed row with the drops culled on the device (or the host); the host's time
-          // making the streaks of its last frame
-          const auto cull_row = [&](bool device, const char* again) {
-            g->set_device_culling(device);
+          // the drops culled on the device (late streaks), two rounds: the host's time making
+          // the streaks (last_late_streaks_ms) and DeviceStreakCull's
+          double cull_device_ms[2] = {0, 0}, cull_run_ms[2] = {0, 0}, cull_stage_ms[2] = {0, 0};
+          for (int round = 0; round < 2; ++round) {
             rows.push_back({name, size,
                             fmt::format("rgb+depth realtime + effects (on GPU), late streaks, "
-                                        "drops culled on the {}{}",
-                                        device ? "device" : "host", again),
+                                        "drops culled on the device{}",
+                                        round == 0 ? "" : ", again"),
                             "cuda", "Render()",
                             1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
-            return g->last_late_streaks_ms();
-          };
-          for (int round = 0; round < 2; ++round) {
-            const char* again = round == 0 ? "" : ", again";
-            cull_host_ms[round] = cull_row(false, again);
-            cull_device_ms[round] = cull_row(true, again);
+            cull_device_ms[round] = g->last_late_streaks_ms();
             cull_run_ms[round] = g->device_drop_cull()->run_ms();
             cull_stage_ms[round] = g->device_drop_cull()->stage_ms();
           }
           builds.push_back(fmt::format(
               "{} {}: late streaks' host time a frame (last timed frame, two rounds): drops "
               "culled on the device {:.3f} / {:.3f} ms (DeviceStreakCull::Queue {:.3f} / {:.3f} "
-              "ms, of which staging {:.3f} / {:.3f} ms), on the host {:.3f} / {:.3f} ms; {} "
-              "streaks, {} rain drops culled",
+              "ms, of which staging {:.3f} / {:.3f} ms); {} streaks, {} rain drops culled",
               name, size, cull_device_ms[0], cull_device_ms[1], cull_run_ms[0], cull_run_ms[1],
-              cull_stage_ms[0], cull_stage_ms[1], cull_host_ms[0], cull_host_ms[1],
-              g->realtime_frame().splat_streaks().View().num,
+              cull_stage_ms[0], cull_stage_ms[1], g->realtime_frame().splat_streaks().View().num,
               g->realtime_frame().streaks_culled()));
           // where one rain frame's time goes (device culling, late streaks: the defaults), the
           // median of 21 frames by wall time: the host's clock from Render's start, the frame's
@@ -1207,55 +965,23 @@ int Main(int argc, char** argv) {
           builds.push_back(fmt::format(
               "{} {}: particles: {} streaks after the host's culling, {} streak pixels; host "
               "preparation {:.2f} ms a frame with the device splat (late streaks: before the "
-              "kernels, and {:.2f} ms making the streaks while the GPU works; {:.2f} ms with the "
-              "streaks made before the kernels), {:.2f} ms with the host splat "
-              "(CudaRenderer::last_prepare_ms and last_late_streaks_ms of the last timed frame)",
-              name, size, streaks, host_pixels, prep_device, late_ms, prep_serial, prep_host));
-          // every output of a late-streaks frame and of a serial one, to the bit
-          RenderedFrame late_frame, serial_frame;
+              "kernels, and {:.2f} ms making the streaks while the GPU works), {:.2f} ms with the "
+              "host splat (CudaRenderer::last_prepare_ms and last_late_streaks_ms of the last "
+              "timed frame)",
+              name, size, streaks, host_pixels, prep_device, late_ms, prep_host));
+          // every output of a frame, to compare builds
+          RenderedFrame late_frame;
           gpu->Render(snap, fx.get(), rgb, &late_frame);
-          g->set_late_streaks(false);
-          gpu->Render(snap, fx.get(), rgb, &serial_frame);
-          g->set_late_streaks(true);
           const auto bytes = [](const auto& v) {
             return std::string_view(reinterpret_cast<const char*>(v.data()),
                                     sizeof(v[0]) * v.size());
           };
-          for (const auto& [what, f] :
-               {std::pair<const char*, const RenderedFrame*>{"late streaks", &late_frame},
-                {"streaks before the kernels", &serial_frame}})
-            builds.push_back(fmt::format(
-                "{} {}: effects frame, {}: FNV-1a of rgb / depth / radiance {:016x} / {:016x} / "
-                "{:016x}, EV100 {:.17g}",
-                name, size, what, Fnv1a64(bytes(f->rgb.data)), Fnv1a64(bytes(f->depth_m.data)),
-                Fnv1a64(bytes(f->radiance.data)), f->ev100));
-          // and of a frame whose drops the host culled
-          RenderedFrame host_cull_frame;
-          g->set_device_culling(false);
-          gpu->Render(snap, fx.get(), rgb, &host_cull_frame);
-          g->set_device_culling(true);
           builds.push_back(fmt::format(
-              "{} {}: effects frame, drops culled on the host: FNV-1a of rgb / depth / radiance "
-              "{:016x} / {:016x} / {:016x}, EV100 {:.17g}; the device culling's frame "
-              "bit-identical: {}",
-              name, size, Fnv1a64(bytes(host_cull_frame.rgb.data)),
-              Fnv1a64(bytes(host_cull_frame.depth_m.data)),
-              Fnv1a64(bytes(host_cull_frame.radiance.data)), host_cull_frame.ev100,
-              late_frame.rgb.data == host_cull_frame.rgb.data &&
-                      late_frame.depth_m.data == host_cull_frame.depth_m.data &&
-                      late_frame.radiance.data == host_cull_frame.radiance.data &&
-                      std::memcmp(&late_frame.ev100, &host_cull_frame.ev100, sizeof(double)) == 0
-                  ? "yes"
-                  : "NO"));
-          const bool same =
-              late_frame.rgb.data == serial_frame.rgb.data &&
-              late_frame.depth_m.data == serial_frame.depth_m.data &&
-              late_frame.radiance.data == serial_frame.radiance.data &&
-              std::memcmp(&late_frame.ev100, &serial_frame.ev100, sizeof(double)) == 0;
-          builds.push_back(
-              fmt::format("{} {}: late streaks and streaks before the kernels "
-                          "bit-identical (rgb, depth, radiance, EV100): {}",
-                          name, size, same ? "yes" : "NO"));
+              "{} {}: effects frame: FNV-1a of rgb / depth / radiance {:016x} / {:016x} / "
+              "{:016x}, EV100 {:.17g}",
+              name, size, Fnv1a64(bytes(late_frame.rgb.data)),
+              Fnv1a64(bytes(late_frame.depth_m.data)), Fnv1a64(bytes(late_frame.radiance.data)),
+              late_frame.ev100));
         }
         if (!fx->homogeneous_media.empty() || !fx->grid_media.empty())
           builds.push_back(fmt::format(

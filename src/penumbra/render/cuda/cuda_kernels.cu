@@ -16,11 +16,11 @@
 #include "penumbra/core/error.h"
 #include "penumbra/core/exp_rn.h"
 #include "penumbra/render/analytic_shape_math.h"
-#include "penumbra/render/cuda/bvh_traversal.h"
+#include "penumbra/render/bvh/bvh_traversal.h"
 #include "penumbra/render/cuda/cuda_device_buffer.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
-#include "penumbra/render/cuda/primary_pixel.h"
-#include "penumbra/render/cuda/realtime_shading.h"
+#include "penumbra/render/transport/primary_pixel.h"
+#include "penumbra/render/transport/realtime.h"
 
 namespace penumbra::cuda {
 namespace {
@@ -99,9 +99,8 @@ struct DeviceScene::Impl {
   // RenderPrimary's pinned copies: the staging buffers, band k's images staged, and the stage
   // events (timing)
   PinnedBuffer pin_out[6];
-  cudaEvent_t band_staged[kMaxPrimaryBands] = {};
+  cudaEvent_t band_staged[kPrimaryBands] = {};
   cudaEvent_t primary_start = nullptr, primary_traced = nullptr, primary_copied = nullptr;
-  PrimaryCopyOptions primary_options;
   PrimaryTimes primary_times;
   Buffer camera_xy, camera_rows;
   int64_t camera_xy_version = -1;
@@ -166,10 +165,6 @@ DeviceScene::~DeviceScene() {
   delete impl_;
 }
 
-void DeviceScene::set_primary_options(const PrimaryCopyOptions& options) {
-  impl_->primary_options = options;
-}
-const PrimaryCopyOptions& DeviceScene::primary_options() const { return impl_->primary_options; }
 const PrimaryTimes& DeviceScene::last_primary_times() const { return impl_->primary_times; }
 
 void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_version, bool wait) {
@@ -280,7 +275,6 @@ void DeviceScene::RenderPrimary(const PinholeCamera& c, const PrimaryOutputs& wa
   const auto t0 = std::chrono::steady_clock::now();
   const int64_t pixels = static_cast<int64_t>(c.width) * c.height;
   if (pixels <= 0) return;
-  const PrimaryCopyOptions& o = m.primary_options;
   if (!m.primary_start) {
     for (cudaEvent_t& e : m.band_staged)
       Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
@@ -297,25 +291,22 @@ void DeviceScene::RenderPrimary(const PinholeCamera& c, const PrimaryOutputs& wa
   const Plane planes[6] = {{want.depth, d.depth, 4},     {want.geom_id, d.geom_id, 4},
                            {want.range, d.range, 4},     {want.normal_O, d.normal_O, 12},
                            {want.body_id, d.body_id, 4}, {want.semantic, d.semantic, 4}};
-  const bool pinned = o.pinned;
-  if (pinned)
-    for (int p = 0; p < 6; ++p)
-      if (planes[p].host) m.pin_out[p].Reserve(planes[p].px * pixels);
-  // the kernel over the whole frame (bands of it would each end on their slowest rays); pinned:
-  // the images go back in bands of rows, band k behind its event, so that the host copies band
+  for (int p = 0; p < 6; ++p)
+    if (planes[p].host) m.pin_out[p].Reserve(planes[p].px * pixels);
+  // the kernel over the whole frame (bands of it would each end on their slowest rays); the
+  // images go back in bands of rows, band k behind its event, so that the host copies band
   // k into the caller's buffers while band k + 1 comes back (a small frame in one band)
   size_t frame_bytes = 0;
   for (const Plane& p : planes)
     if (p.host) frame_bytes += p.px * pixels;
-  const size_t serial = static_cast<size_t>(std::max(o.serial_copy_kib, 0)) << 10;
-  const int bands = !pinned || frame_bytes <= serial ? 1 : std::clamp(o.bands, 1, kMaxPrimaryBands);
+  const int bands = frame_bytes <= kPrimarySerialBytes ? 1 : kPrimaryBands;
   const int band_rows = (c.height + bands - 1) / bands;
   const dim3 block(8, 8);
   Check(cudaEventRecord(m.primary_start, m.stream), "cudaEventRecord");
   PrimaryKernel<<<dim3((c.width + 7) / 8, (c.height + 7) / 8), block, 0, m.stream>>>(m.view, c, d);
   Check(cudaGetLastError(), "PrimaryKernel launch");
   Check(cudaEventRecord(m.primary_traced, m.stream), "cudaEventRecord");
-  if (pinned) {
+  {
     std::vector<HostCopy> copies;
     for (int k = 0; k < bands; ++k) {
       const int r0 = std::min(c.height, k * band_rows);
@@ -336,13 +327,7 @@ void DeviceScene::RenderPrimary(const PinholeCamera& c, const PrimaryOutputs& wa
       Check(cudaEventRecord(m.band_staged[k], m.stream), "cudaEventRecord");
     }
     Check(cudaEventRecord(m.primary_copied, m.stream), "cudaEventRecord");
-    ParallelCopy(o.parallel_copies ? parallel : ParallelFn(), copies, size_t{256} << 10, serial);
-  } else {
-    for (const Plane& p : planes)
-      if (p.host)
-        Check(cudaMemcpyAsync(p.host, p.dev, p.px * pixels, cudaMemcpyDeviceToHost, m.stream),
-              "copying an image back");
-    Check(cudaEventRecord(m.primary_copied, m.stream), "cudaEventRecord");
+    ParallelCopy(parallel, copies, size_t{256} << 10, kPrimarySerialBytes);
   }
   Check(cudaStreamSynchronize(m.stream), "PrimaryKernel");
   float kernel_ms = 0, copies_ms = 0;

@@ -9,8 +9,8 @@
 #include <functional>
 #include <string>
 
-#include "penumbra/render/cuda/bvh_types.h"
-#include "penumbra/render/cuda/primary_pixel.h"
+#include "penumbra/render/bvh/bvh_types.h"
+#include "penumbra/render/transport/primary_pixel.h"
 
 namespace penumbra::cuda {
 
@@ -37,51 +37,16 @@ bool ProbeDevice(std::string* name, std::string* why);
 /// @throws Error on a CUDA failure.
 void ExpRnOnDevice(const float* x, float* y, int64_t n);
 
-/// a pinhole camera as the primary-ray kernel takes it: world ray through pixel (u, v) (pixel
-/// centres are integers) is o + t (((u - cx) inv_fx) ex + ((v - cy) inv_fy) ey + ez), as
-/// Camera::GenerateRay (render/camera.h) for a camera without distortion or motion.
-struct PinholeCamera {
-  F3 o, ex, ey, ez;
-  float cx = 0, cy = 0, inv_fx = 1, inv_fy = 1;
-  float near = 0;
-  int width = 0, height = 0;
-  /// a camera with lens distortion: (height x width x 2) undistorted normalised coordinates
-  /// (x, y) of the pixel centres, used instead of ((u - cx) inv_fx, (v - cy) inv_fy); null = a
-  /// pinhole. a moving camera (rolling shutter): (height x 12) per row o, ex, ey, ez, used
-  /// instead of the fields above; null = one pose. both in the memory the reader runs in (host
-  /// or device); render/cuda/camera_rays.h fills them.
-  const float* xy = nullptr;
-  const float* rows = nullptr;
-};
-
 /// runs body(0) .. body(count - 1), in any order and possibly at once (a thread pool); the
 /// renderers pass their pool's ParallelFor so that the host copies outputs on all its threads.
 using ParallelFn = std::function<void(int64_t count, const std::function<void(int64_t)>& body)>;
 
-/// the most bands of rows PrimaryCopyOptions::bands may ask for.
-constexpr int kMaxPrimaryBands = 16;
-
-/// how DeviceScene::RenderPrimary brings its images back (the defaults are the fast ones; the
-/// others stay for the benchmark's rows, render_cuda_bench --realtime). every variant writes
-/// the same bytes.
-struct PrimaryCopyOptions {
-  /// the images go back to page-locked staging buffers and the host copies them into the
-  /// caller's buffers in 256 KiB chunks (over `parallel`); else the device copies them into the
-  /// caller's (pageable) buffers directly, one after the other, after the kernel.
-  bool pinned = true;
-  /// with pinned copies: the images go back in this many bands of rows (1 to
-  /// kMaxPrimaryBands), the host copying band k into the caller's buffers while band k + 1
-  /// comes back; a frame whose images hold at most serial_copy_kib goes back in one. the
-  /// kernel traces the whole frame at once.
-  int bands = 4;
-  /// with pinned copies: the host's copies over RenderPrimary's `parallel` (else on the calling
-  /// thread alone).
-  bool parallel_copies = true;
-  /// with pinned copies: a frame whose images hold at most this many KiB goes back in one
-  /// band and is copied on the calling thread alone (waking the pool costs more than such
-  /// copies).
-  int serial_copy_kib = 512;
-};
+/// RenderPrimary's images go back in this many bands of rows, the host copying band k into the
+/// caller's buffers while band k + 1 comes back; a frame whose images hold at most
+/// kPrimarySerialBytes goes back in one band and is copied on the calling thread alone (waking
+/// the pool costs more than such copies).
+constexpr int kPrimaryBands = 4;
+constexpr size_t kPrimarySerialBytes = size_t{512} << 10;
 
 /// where RenderPrimary's time went, milliseconds (benchmarks).
 struct PrimaryTimes {
@@ -117,13 +82,12 @@ class DeviceScene {
   void Trace(const TraceRay* rays, int64_t n, TraceHit* hits);
   /// occlusion of n rays (host arrays): occluded[i] = 1 if blocked.
   void Occluded(const TraceRay* rays, int64_t n, uint8_t* occluded);
-  /// one camera's primary rays: the ground-truth images of `out` (copied back to the host, as
-  /// primary_options() says; the host's copies over `parallel` when it is given).
+  /// one camera's primary rays: the ground-truth images of `out`, copied back to page-locked
+  /// staging in kPrimaryBands bands of rows, then by the host into `out` in 256 KiB chunks
+  /// (over `parallel` when it is given).
   void RenderPrimary(const PinholeCamera& camera, const PrimaryOutputs& out,
                      const ParallelFn& parallel = {});
-  /// the options of the next RenderPrimary calls, and the stages of the last one.
-  void set_primary_options(const PrimaryCopyOptions& options);
-  const PrimaryCopyOptions& primary_options() const;
+  /// the stages of the last RenderPrimary.
   const PrimaryTimes& last_primary_times() const;
   /// `count` renders of `camera` into device memory only (no copy back), timed with CUDA
   /// events: the mean milliseconds per frame (benchmarks).

@@ -1,29 +1,28 @@
 #pragma once
-// the realtime tier on the GPU (realtime_shading.h per pixel, realtime_frame.h on the host):
-// device copies of a scene's materials, textures, geoms and lights, and the frame's kernels.
-// implemented in realtime_kernels.cu; plain structs only here (no Eigen, no CUDA headers).
-// every function throws penumbra::Error naming the CUDA call when the runtime reports an error.
+// the realtime tier on the GPU (render/transport/realtime.h per pixel, realtime_frame.h on the
+// host): device copies of a scene's materials, textures, geoms and lights, and the frame's
+// kernels (realtime_kernels.cuh: realtime_device.cu for a frame, realtime_batch.cu for a batch).
+// plain structs only here (no Eigen, no CUDA headers). every function throws penumbra::Error
+// naming the CUDA call when the runtime reports an error.
 //
-// a frame: (1) a kernel traces every pixel's primary ray and writes its geometry and depth
-// (and, by default, the hit's material terms, SurfaceTerms, for the shading kernel);
-// with a mirror layer in the scene it also traces the mirrored rays (TraceMirrorRay);
-// (2) a kernel turns the geometry into sky terms, one thread per 2x2 quad (QuadSkyTerms) and,
-// with a mirror layer, one per mirrored ray (MirrorSkyTerm): the shared lookups of
-// render/sky_eval_math.h over the device copies of the SkyModel's and SkyIrradianceVolume's
-// arrays (UploadSky), the functions the CPU backend calls. the sky terms can still be made on
-// the host instead (RealtimeKernelOptions::device_sky false, the benchmark's ablation: `sky`
-// runs the same functions on the CPU, realtime_frame.h, in bands of rows with pinned copies,
-// RealtimeKernelOptions::sky_bands: band k's geometry comes back while the host computes band
-// k - 1's sky terms, and band k's shading kernel runs while the host computes band k + 1's);
-// (3) the shading kernel (ShadeRealtimeStored, or ShadeRealtimePixel), the shared visibility's
-// kernels (a warp's penumbra rays spread over its lanes) and
-// the mirror layer's (ShadeMirrorHit, ApplyMirrorLayer); (4) per-row log-luminance sums, which
-// one thread block turns into the frame's EV100 and exposures (film_math.h's FrameExposure, the
-// rows added in row order: RealtimeKernelOptions::device_exposure; else the host, `exposure`,
-// between the row sums and the film kernel); (5) the film kernel (DevelopPixel). the host
-// computes the exposure from the same row sums too and, in the rare frame where the device's
-// double exp, log2 and exp2 gave other float exposures than its C library, develops the frame
-// again with its own: the rgb and EV100 are always the host path's bits.
+// a frame: (1) a kernel traces every pixel's primary ray and writes its geometry, depth and the
+// hit's material terms (SurfaceTerms, for the shading kernel); with a mirror layer in the scene
+// it also traces the mirrored rays (TraceMirrorRay); (2) a kernel turns the geometry into sky
+// terms, one thread per 2x2 quad (QuadSkyTerms) and, with a mirror layer, one per mirrored ray
+// (MirrorSkyTerm): the shared lookups of render/sky_eval_math.h over the device copies of the
+// SkyModel's and SkyIrradianceVolume's arrays (UploadSky), the functions the CPU backend calls;
+// (3) the shading kernel (ShadeRealtimeStored; small frames with their shadow rays through a
+// queue), the shared visibility's kernels (a warp's penumbra rays spread over its lanes, the
+// fraction and resolve a block per shadow tile) and the mirror layer's (ShadeMirrorHit,
+// ApplyMirrorLayer; on a second stream of the lowest priority beside the frame's); (4) per-row
+// log-luminance sums, which one thread block turns into the frame's EV100 and exposures
+// (film_math.h's FrameExposure, the rows added in row order; frames of more than
+// kMaxDeviceExposureRows rows: the host, `exposure`, between the row sums and the film kernel);
+// (5) the film kernel (DevelopPixel). the host computes the exposure from the same row sums too
+// and, in the rare frame where the device's double exp, log2 and exp2 gave other float exposures
+// than its C library, develops the frame again with its own: the rgb and EV100 are always the
+// host path's bits. the outputs come back through page-locked buffers (the radiance in bands of
+// rows as they are resolved), copied into the frame's images over RealtimeOutputs::parallel.
 // every sum runs in a fixed order and no atomics touch an output: frames are bit-identical run to
 // run on one GPU.
 
@@ -32,8 +31,8 @@
 #include <vector>
 
 #include "penumbra/render/cuda/cuda_kernels.h"
-#include "penumbra/render/cuda/realtime_shading.h"
 #include "penumbra/render/film_math.h"
+#include "penumbra/render/transport/realtime.h"
 
 namespace penumbra::cuda {
 
@@ -56,8 +55,7 @@ struct RealtimeFilm {
   float white_balance_gains[3] = {1, 1, 1};  ///< the view's (CameraView::white_balance_gains)
 };
 
-/// how Render's exposures on the device compared with the host's, over the frames so far
-/// (RealtimeKernelOptions::device_exposure).
+/// how Render's exposures on the device compared with the host's, over the frames so far.
 struct RealtimeExposureChecks {
   int64_t frames = 0;         ///< frames whose exposure the device computed
   int64_t ev100_differs = 0;  ///< of them, frames whose device EV100 differed in some bit
@@ -86,190 +84,33 @@ struct RealtimeSky {
   int64_t num_probes = 0;
 };
 
-/// the most bands of rows RealtimeKernelOptions::sky_bands may ask for.
-constexpr int kMaxSkyBands = 16;
-
-/// how the realtime kernels run (the defaults are the fast ones; the others stay for the
-/// benchmark's ablations, render_cuda_bench --realtime). every variant computes the same
-/// radiance and depth; only the order of a row's log-luminance sum (rows_per_warp) could move
-/// the exposure's last bits.
-struct RealtimeKernelOptions {
-  /// the shading kernel takes the primary hit the geometry kernel traced (else it traces it
-  /// again).
-  bool reuse_hit = true;
-  /// with reuse_hit: the geometry kernel keeps each hit's material terms (SurfaceTerms, 40 bytes
-  /// a pixel) and the shading kernel shades from them and the primary geometry
-  /// (ShadeRealtimeStored) instead of evaluating the surface (textures, normal map) again.
-  bool reuse_surface = true;
-  /// one warp sums a row's log-luminance terms (32 strided partial sums, then a fixed tree);
-  /// else one thread sums the row in column order.
-  bool rows_per_warp = true;
-  /// Render() copies through page-locked host buffers (the geometry and sky terms' round trip,
-  /// the row sums, and the outputs, which are then copied into the frame's images; the depth
-  /// and radiance on a second stream, overlapped); else to and from pageable memory directly.
-  bool pinned = true;
-  /// with pinned copies and host sky terms (device_sky false), Render()'s bands of rows (1 to
-  /// kMaxSkyBands): band k's geometry goes to the host, its sky terms come back and it is shaded
-  /// while the host computes band k + 1's (1: the whole frame at once). pageable copies: always 1.
-  int sky_bands = 4;
-  /// the shading kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
-  /// 0 or 1 leaves the registers to the compiler (130); 4 caps them at 128 a thread (4 blocks an
-  /// SM instead of 3, no spills), 6 at 85 (more warps in flight, spills). with reuse_hit only.
-  int min_blocks = 4;
-  /// with reuse_surface and min_blocks 4 or 5 (the 128-register kernel, the default): the
-  /// shading kernel keeps the lights' unshadowed terms between its two light loops
-  /// (ShadeRealtimePoint: the first kShadeCachedLights lights' contribution, direction and
-  /// distance, 28 bytes a light and pixel) in its block's shared memory (StridedLightTerms:
-  /// 3.5 KiB a light for 128 threads, 31.5 KiB for the house's 9 lights) instead of each
-  /// thread's stack in local memory (LocalLightTerms; the stack goes from 1,280 to 832 bytes):
-  /// the same values, so the same bits.
-  bool shared_light_terms = true;
-  /// with reuse_surface: small frames shade with their shadow rays apart, in three passes
-  /// (branch gpu22; realtime_shading.h's ShadeQueuedStored, SumQueuedLights): a kernel evaluates
-  /// every light's unshadowed term, keeps the lit ones' contributions (area_c) and puts the
-  /// shadow rays worth tracing into one queue for the frame (32 bytes a ray, room for one per
-  /// pixel and light); a lean kernel traces the queue, each verdict a bit of its pixel's mask
-  /// (integer atomicOr); a third sums each pixel's lights in light order as the fused kernel
-  /// does: the same bits. small: the frame's pixels (a batch's: all its cameras') fit one wave
-  /// of the fused kernel's blocks (4 blocks of 128 threads an SM; 67,584 pixels on an H100's
-  /// 132 SMs), where that kernel leaves SMs idle and the queue spreads the rays over all of
-  /// them (128x128 on an H100: the house's kernels 0.267 ms instead of 0.305); larger frames
-  /// fill the device, and there the fused kernel, whose shading hides its rays' latency, is
-  /// faster (640x480: 0.722 against 0.757 ms). frames of more than kMaxQueuedShadowLights
-  /// lights take the fused kernel.
-  bool queue_shadow_rays = true;
-  /// with queue_shadow_rays: every frame's shadow rays through the queue, whatever its size.
-  bool queue_shadow_rays_always = false;
-  /// the geometry kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
-  /// 5 caps its registers at 102 (five blocks an SM, as before it kept the material terms for
-  /// reuse_surface), below 5 leaves them to the compiler.
-  int geometry_min_blocks = 5;
-  /// with pinned copies, the radiance goes back in this many bands of rows (1 to
-  /// kMaxSkyBands), each copied into the frame's image while the next one comes back.
-  int output_bands = 2;
-  /// the shared visibility's penumbra rays: a warp's rays spread over its 32 lanes
-  /// (VisibilityRaysWarpKernel, the same integer counts); else each pixel traces its own in
-  /// turn (SharedVisibilityRays).
-  bool warp_penumbra = true;
-  /// the shared visibility's long penumbra jobs (more than 8 rays: a tile's ring traces up to
-  /// 63) through one queue for the whole frame (or batch): their rays go into chunks of 4 that
-  /// every thread of the device takes from, the pixels' integer counts summed with integer
-  /// atomics (the same counts, so the same bits), so no warp waits on its ring pixels; the
-  /// short ones spread over their warp's lanes (as warp_penumbra, which this implies).
-  bool queue_penumbra = true;
-  /// with queue_penumbra: the rays of a queued chunk (1 to 8; a batch's chunks hold 4). a
-  /// thread of VisibilityChunkKernel traces its chunk's rays one after another, so where the
-  /// queue holds fewer chunks than the device has threads (the house's narrow penumbrae) the
-  /// kernel lasts as long as one chunk's rays; shorter chunks shorten it, at one integer atomic
-  /// a chunk. the same integer counts, so the same bits.
-  int penumbra_chunk_rays = 1;
-  /// with device_sky, a frame with a mirror layer traces, sky-terms and shades its mirrored rays
-  /// (MirrorTraceKernel, MirrorSkyKernel, MirrorShadeKernel) on a second stream that forks from
-  /// the frame's stream after the geometry kernel and joins it before the mirror blend, so they
-  /// run beside the sky quads, the shading and the shared visibility (which neither read nor
-  /// write their arrays: the same bits); else after them on the frame's stream.
-  bool mirror_stream = true;
-  /// with mirror_stream: the side stream has the device's lowest priority, below the frame's
-  /// stream (DeviceScene's, the highest), so the mirror layer's blocks take the SMs the frame's
-  /// own kernels leave; else the same priority as the frame's stream.
-  bool mirror_low_priority = true;
-  /// the shared visibility's resolve and the mirror blend in one kernel (the mirrored radiance
-  /// shaded before it), launched in the radiance's output_bands bands of rows, each band's copy
-  /// back behind its own event (without media and streaks, which change the radiance after
-  /// it): band k goes back while band k + 1 is resolved and the row sums run. else the resolve,
-  /// then the blend over the whole frame, and the copies behind the row sums.
-  bool fuse_resolve = true;
-  /// the shared visibility's fraction and resolve (with fuse_resolve also the mirror blend) in
-  /// one kernel of a block per 16x16 shadow tile (VisibilityTileKernel; a batch's too): the
-  /// tile's verdicts, ray counts and fractions of one light after another in shared memory,
-  /// where every pixel's window finds its neighbours (the windows never leave their tile), the
-  /// same functions on the same values (SharedWindowFraction, SharedLampFraction), so the same
-  /// bits; else VisibilityFractionKernel, then the resolve, each reading its neighbours from the
-  /// frame's arrays.
-  bool tile_visibility = true;
-  /// with tile_visibility: the tile kernel packs each pixel's two ray counts once into one word
-  /// of shared memory (ShadowWindowCounts, render/shadow_window_math.h), which the window's
-  /// integer sums read at each tap; else it keeps both floats there and packs them at each tap
-  /// (WindowTapCounts). the same integers, so the same bits.
-  bool packed_window_counts = true;
-  /// with warp_penumbra or queue_penumbra: the penumbra rays' kernel in blocks of one 16x16
-  /// shadow tile that copy every light's verdicts of their tile into shared memory first, where
-  /// each pixel's window looks for a penumbra (SharedVisibilityPenumbra; frames of at most 128
-  /// lights, a batch's too); else blocks of 16x8 pixels reading the frame's verdicts.
-  bool tile_penumbra = true;
-  /// with tile_penumbra: the penumbra rays' tile blocks copy each pixel's surface (geom of a
-  /// hit, normal, point: TileWindowSurfaces) into shared memory once, where the window masks
-  /// read their neighbours' (SharedVisibilityWindow; else each pixel's PixelGeometry is read
-  /// from global memory by up to 25 threads). the same masks, so the same bits.
-  bool staged_window = true;
-  /// with staged_window: those blocks keep every light's verdicts as the tile's bit rows (two
-  /// ballots a warp: RowWindowVerdicts, ShadowWindowVerdicts), where a window sees both
-  /// verdicts or not in five shifted rows; else as an int8 copy read at each set bit of the
-  /// window (StridedWindowVerdicts). the same booleans, so the same bits.
-  bool window_verdict_rows = true;
-  /// occlusion rays (the lights' shadow rays, the penumbra rays) walk the top level over the
-  /// instances' world boxes (SceneView::tlas, TraceOccluded in bvh_traversal.h); else they test
-  /// every instance's box in turn. the same verdicts, so the same bits.
-  bool occlusion_tlas = true;
-  /// closest hits (the camera's rays, the mirror's) walk the same top level nearer child first
-  /// (TraceClosest); else they test every instance in index order. the same hits, so the same
-  /// bits.
-  bool closest_tlas = true;
-  /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
-  /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
-  bool device_sky = true;
-  /// with pinned copies and at most kMaxDeviceExposureRows rows: the exposure is computed on
-  /// the device after the row sums (one block, FrameExposure) and the film kernel reads it there,
-  /// so Render synchronises once, at the end (the host checks the device's exposures against
-  /// its own, Render's `exposure`, and develops again in the rare frame where they differ);
-  /// else the row sums go to the host, which computes the exposure and then launches the film
-  /// kernel.
-  bool device_exposure = true;
-  /// Render uploads the posed geoms and lights only when their bytes differ from the last
-  /// upload's (else every frame).
-  bool upload_changed_only = true;
-  /// with pinned copies, the host copies the outputs into the frame's images in chunks over
-  /// RealtimeOutputs::parallel (else on the calling thread alone).
-  bool parallel_copies = true;
-  /// the size of those chunks, KiB (at least 4).
-  int copy_chunk_kib = 256;
-  /// with parallel_copies: a loop of copies of at most this many KiB (a small frame's) runs on
-  /// the calling thread alone (waking the pool costs more than such copies).
-  int serial_copy_kib = 512;
-};
-
 /// the most rows whose sums the device's exposure takes (its block keeps them in shared
 /// memory); taller frames take the host's.
 constexpr int kMaxDeviceExposureRows = 6144;
 
 /// the time of Render()'s stages, milliseconds (benchmarks). geometry + sky + shade + film =
-/// total. with device_sky the first three are CUDA-event times on the GPU's stream (no
-/// synchronisation between them) and film is the rest of the host clock's total; else all are
-/// host clock times.
+/// total. the first three are CUDA-event times on the GPU's stream (no synchronisation between
+/// them) and film is the rest of the host clock's total.
 struct RealtimeStageTimes {
-  /// device_sky: the geoms' and lights' upload and the geometry (and mirrored-ray) kernels;
-  /// else those and the first band's geometry on the host
+  /// the geoms' and lights' upload and the geometry (and mirrored-ray) kernels
   double geometry = 0;
-  /// device_sky: the sky-term kernels; else the host's sky terms, all bands
-  /// (RealtimeFrameData::FrameSkyTerms)
+  /// the sky-term kernels
   double sky = 0;
-  /// device_sky: the shading, shared-visibility, mirror-layer and row-sum kernels and the row
-  /// sums' copy; else the rest until the row sums are on the host: waiting for the other
-  /// bands' geometry, sky terms up, those kernels, row sums back
+  /// the shading, shared-visibility, mirror-layer and row-sum kernels (and, for frames too tall
+  /// for the device's exposure, the row sums' copy)
   double shade = 0;
-  /// exposure, film kernel, the outputs copied to the frame's images (device_sky: and the
-  /// host's launch and wait overheads; with device_exposure the shade stage ends at the row
-  /// sums, and this is the rest)
+  /// exposure, film kernel, the outputs copied to the frame's images, and the host's launch and
+  /// wait overheads (the shade stage ends at the row sums, and this is the rest)
   double film = 0;
-  /// of film: the host's copies of the radiance and rgb into the frame's images (pinned), from
-  /// the copy stream's end to the last copy (the depth is copied while the GPU shades); with
-  /// device_exposure from the end of the launches, so it includes waiting for the kernels
+  /// of film: the host's copies of the radiance and rgb into the frame's images (the depth is
+  /// copied while the GPU shades), from the end of the launches, so it includes waiting for the
+  /// kernels
   double outputs = 0;
   double total = 0;
   /// host clock: from the start until every kernel and copy of the frame is queued (the host's
   /// waits for the outputs come after)
   double launched = 0;
-  /// device_sky with device_exposure (else 0), CUDA events from the frame's first event on the
+  /// with the device's exposure (else 0), CUDA events from the frame's first event on the
   /// stream (before the geoms' upload): the film kernel's end, and the end of the last copy to
   /// page-locked memory (the rgb's, row sums' and exposure's, or the radiance's last band); the
   /// host's clock total minus copies_end is what the host adds after the device: its
@@ -283,7 +124,7 @@ struct RealtimeStageTimes {
 /// Film::exposure_pod) and white-balanced (linear rgb gains, ones = none), its tone map and its
 /// world's encoding table (device pointer, DeviceRealtime::device_lut). the batch computes the
 /// per-channel exposures from the camera's row sums on the device (film_math.h's
-/// FrameExposure, as Render's device_exposure).
+/// FrameExposure, as Render's).
 struct RealtimeBatchFilm {
   FilmExposurePod exposure;
   float white_balance_gains[3] = {1, 1, 1};
@@ -306,15 +147,15 @@ struct RealtimeBatchTimes {
 };
 
 /// film_math.h's FrameExposure of `rows` (row-major sums of a frame of `pixels` pixels, at
-/// most kMaxDeviceExposureRows) computed on the device as Render's device_exposure does it
+/// most kMaxDeviceExposureRows) computed on the device as Render does it
 /// (tests: the device's EV100 and exposures against the host's).
 /// @throws Error for too many rows, or if the CUDA runtime fails.
 double DeviceFrameExposure(const FilmExposurePod& film, const std::vector<double>& rows,
                            int64_t pixels, const float white_balance_gains[3], float exposure[3]);
 
 /// the realtime tier over a batch of cameras of the same size (cuda_batch_renderer.h): each
-/// stage of Render's default path (device sky terms, stored surfaces, warp-shared penumbra rays,
-/// a warp per row's sum) launched once over every camera of the batch, camera k in the grid's
+/// stage of Render's (device sky terms, stored surfaces, warp-shared penumbra rays, a warp per
+/// row's sum) launched once over every camera of the batch, camera k in the grid's
 /// z (the row sums' and film's y); camera k's images are the same bits as Render of that camera
 /// alone. each camera's exposure is computed on the device from its row sums (one block a
 /// camera: film_math.h's FrameExposure over the rows in row order, the function the host's
@@ -370,20 +211,14 @@ class DeviceRealtime {
   void Upload(const RealtimeStatic& data);
 
   /// copies the sky's and the sky volume's arrays to the device (after Upload: the skybox is
-  /// decoded through its sRGB table); Render's device_sky path needs it once, and again
+  /// decoded through its sRGB table); Render needs it before the first frame, and again
   /// whenever they change (RealtimeFrameData::sky_generation).
   void UploadSky(const RealtimeSky& data);
 
-  /// host sky pass: the sky terms of the pixels of rows [row0, row1) from their primary
-  /// geometry, and of their mirrored rays from theirs (mirror and mirror_sky null when the
-  /// frame has no mirror layer, RealtimeFrameView::any_mirror). every array holds all n
-  /// pixels of the frame (row-major); row0 is even, row1 even or the last row + 1.
-  using SkyFn = std::function<void(const PixelGeometry* geometry, const PixelGeometry* mirror,
-                                   int64_t n, int row0, int row1, Float3* sky, Float3* mirror_sky)>;
   /// host exposure: the EV100 from the rows' log-luminance sums, and the per-channel exposures.
   using ExposureFn = std::function<double(const std::vector<double>& rows, float exposure[3])>;
 
-  /// the late streaks (Render's `streaks`, branch gpu23): sets the particle streak fields of
+  /// the late streaks (Render's `streaks`): sets the particle streak fields of
   /// *frame (streaks and num_streaks, splat: host arrays that stay valid until Render returns;
   /// RealtimeFrameData::StreakFields) and leaves the rest alone. called on Render's thread once
   /// every kernel before the streaks' is queued, so the host makes the streaks while the GPU
@@ -392,8 +227,8 @@ class DeviceRealtime {
 
   /// renders one frame of `frame` (host pointers for its geoms and lights; the scene arrays,
   /// materials and textures are replaced by the device copies of `scene` and Upload) with
-  /// `num_geoms` geoms; returns the EV100 (`exposure`'s, the host's). `film`: the tone map, and
-  /// the exposure's settings for the device (which must make what `exposure` makes).
+  /// `num_geoms` geoms (after UploadSky); returns the EV100 (`exposure`'s, the host's). `film`: the
+  /// tone map, and the exposure's settings for the device (which must make what `exposure` makes).
   /// `streaks` (may be empty): the frame's particle streaks are made late, and replace
   /// `frame`'s (which should have none): Render queues the geoms' and lights' upload, the media
   /// volumes and the geometry, sky-term and shading kernels (none of which reads the streaks),
@@ -403,15 +238,13 @@ class DeviceRealtime {
   /// exposure, film): the same kernels on the same data as without it, where the splat runs
   /// first, so the same bits. if it throws, Render waits for the queued work and rethrows.
   double Render(DeviceScene* scene, const RealtimeFrameView& frame, int64_t num_geoms,
-                const RealtimeFilm& film, const SkyFn& sky, const ExposureFn& exposure,
-                const RealtimeOutputs& out, const StreaksFn& streaks = StreaksFn());
+                const RealtimeFilm& film, const ExposureFn& exposure, const RealtimeOutputs& out,
+                const StreaksFn& streaks = StreaksFn());
 
   /// `count` runs of the frame's device work as Render left it (geometry, shading, row sums
   /// and film kernels; the sky terms and exposure of the last Render, no copies), timed with
   /// CUDA events: mean milliseconds per frame (benchmarks).
   double TimeKernels(DeviceScene* scene, int count);
-  /// TimeKernels with the kernels run as `options` says (Render's options are unchanged).
-  double TimeKernels(DeviceScene* scene, int count, const RealtimeKernelOptions& options);
 
   /// `host_frame` with this scene's device arrays in place of its host ones: the materials,
   /// textures, texels, sRGB table and sky of Upload and UploadSky, and its posed geoms and lights,
@@ -422,9 +255,6 @@ class DeviceRealtime {
   /// the device copy of the film's encoding table (Upload's oetf_lut).
   const uint8_t* device_lut() const;
 
-  /// the options of the next Render calls.
-  void set_options(const RealtimeKernelOptions& options);
-  const RealtimeKernelOptions& options() const;
   /// the stages of the last Render.
   const RealtimeStageTimes& last_stage_times() const;
   /// the device's exposures against the host's over the Renders so far.

@@ -47,7 +47,7 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, const RenderSettings& 
     emitter_host_ = std::make_unique<PathEmitterHost>(*emitters_);
     if (settings.denoise) denoiser_ = std::make_unique<Denoiser>();
   }
-  set_device_culling(true);
+  SetDeviceDropCuller();
 }
 
 CudaRenderer::~CudaRenderer() = default;
@@ -64,12 +64,7 @@ std::vector<DropSet> DropSetsOf(const EffectsFrame& fx) {
   return sets;
 }
 
-void CudaRenderer::set_device_culling(bool on) {
-  device_culling_ = on;
-  if (!on) {
-    realtime_->set_device_drop_culler(RealtimeFrameData::DeviceDropCuller());
-    return;
-  }
+void CudaRenderer::SetDeviceDropCuller() {
   realtime_->set_device_drop_culler([this](const EffectsFrame& fx, const StreakCullSetup& setup) {
     // made at the first frame with drops (its stream and buffers)
     if (!drop_cull_) drop_cull_ = std::make_unique<DeviceStreakCull>();
@@ -151,9 +146,9 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
   // the camera's ray tables were Prepared by Render (camera_rays_): not computed again; the
   // media volumes' shadow rays on the GPU, over the BVH Render posed
   if (!media_query_) media_query_ = std::make_unique<CudaRayQuery>(*bvh_, device_.get());
-  // late streaks: the drops culled while the GPU traces and shades (set_late_streaks)
-  const bool late = late_streaks_ && realtime_->device_streaks() && effects != nullptr &&
-                    !effects->empty() && !effects->particles.empty();
+  // late streaks: the drops culled while the GPU traces and shades
+  const bool late = realtime_->device_streaks() && effects != nullptr && !effects->empty() &&
+                    !effects->particles.empty();
   late_streaks_ms_ = late_streaks_start_ms_ = 0;
   cull_queued_ = false;
   realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_, media_query_.get(),
@@ -182,10 +177,6 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   out->ev100 = device_realtime_->Render(
       device_.get(), frame, static_cast<int64_t>(realtime_->geoms().size()), film,
-      [&](const PixelGeometry* g, const PixelGeometry* mirror, int64_t count, int row0, int row1,
-          Float3* sky, Float3* mirror_sky) {
-        realtime_->FrameSkyTerms(g, mirror, count, sky, mirror_sky, pool_.get(), row0, row1);
-      },
       [&](const std::vector<double>& rows, float exposure[3]) {
         return realtime_->Ev100(rows, n, exposure);
       },

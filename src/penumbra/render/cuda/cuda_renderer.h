@@ -5,11 +5,22 @@
 // media and particles seen through them: the images
 // of the pixel centre's primary ray (depth, segmentation (geom ids), instance (body) and semantic
 // segmentation, range and normals, traced by bvh_traversal.h's code in cuda_kernels.cu) and, in the
-// realtime tier, rgb and radiance (realtime_shading.h's functions in realtime_kernels.cu; the
-// frame's preparation on the host, realtime_frame.h), and in the pathtraced tier rgb and
-// radiance with media (path_shading.h, since branch gpu14) and particles (path_streaks.h, since
-// branch gpu16) too: every frame of both tiers renders on the GPU (the host prepares each frame
-// and, in the pathtraced tier, denoises and develops it); docs/gpu.md lists what is where.
+// realtime tier, rgb and radiance (render/transport's realtime chain in realtime_kernels.cuh's
+// kernels; the frame's preparation on the host, realtime_frame.h), and in the pathtraced tier rgb
+// and radiance with media and particles too (render/transport's path chain): every frame of both
+// tiers renders on the GPU (the host prepares each frame and, in the pathtraced tier, denoises
+// and develops it); docs/gpu.md lists what is where.
+//
+// a realtime frame with particles whose streaks the frame splats itself
+// (RealtimeFrameData::device_streaks) makes its streaks late: Render prepares the frame without
+// them (RealtimeFrameData::Prepare's `streaks` false), queues the device's work up to the
+// shading, and makes the streaks (RealtimeFrameData::PrepareStreaks) while the GPU traces and
+// shades (DeviceRealtime::Render's `streaks`); their drops are culled on the device
+// (DeviceStreakCull, cuda_streak_cull.h, through RealtimeFrameData's device drop culler: the
+// CPU's StreakCullDrop one thread each, compacted in order), where the streaks stay for the
+// splat, and the culled rain and a non-finite drop's ConfigError come once the frame's outputs
+// are back, before Render returns. the same bits as streaks made and culled on the host before
+// any device work.
 
 #include <chrono>
 #include <memory>
@@ -80,33 +91,12 @@ class CudaRenderer final : public Renderer {
   void set_radiance_output(bool on) { radiance_output_ = on; }
   bool radiance_output() const { return radiance_output_; }
 
-  /// whether a realtime rgb frame with particles whose streaks the frame splats itself
-  /// (RealtimeFrameData::device_streaks, the default) makes its streaks late (default true,
-  /// branch gpu23): Render prepares the frame without them (RealtimeFrameData::Prepare's
-  /// `streaks` false), queues the device's work up to the shading, and makes the streaks
-  /// (RealtimeFrameData::PrepareStreaks: the drops culled on the device, set_device_culling, or
-  /// by ParticleStreaks::Build) while the GPU traces and shades
-  /// (DeviceRealtime::Render's `streaks`); off, the streaks are made in Prepare, before any
-  /// device work (as before). both give the same bits (the same kernels on the same data).
-  void set_late_streaks(bool on) { late_streaks_ = on; }
-  bool late_streaks() const { return late_streaks_; }
-  /// whether a realtime frame whose streaks the frame splats itself culls its drops on the
-  /// device (default true, branch gpu27: RealtimeFrameData::set_device_drop_culler with
-  /// DeviceStreakCull, cuda_streak_cull.h: the drops uploaded, decided by the CPU's shared
-  /// StreakCullDrop one thread each on a high-priority stream and compacted in order; since
-  /// branch gpu30 the streaks stay on the device, where the splat reads them and their count,
-  /// and the host does not wait: the culled rain (RealtimeFrameData::streaks_culled) and a
-  /// non-finite drop's ConfigError come once the frame's outputs are back, before Render
-  /// returns; the same streaks and bits as the host's culling); off, the host culls them
-  /// (ParticleStreaks::Build over the pool, as before).
-  void set_device_culling(bool on);
-  bool device_culling() const { return device_culling_; }
   /// the device's drop culling (null until a frame with drops culled them on the device; benchmarks
   /// read its last Run's times, DeviceStreakCull::run_ms and stage_ms).
   const DeviceStreakCull* device_drop_cull() const { return drop_cull_.get(); }
   /// host milliseconds of the last rgb frame on the GPU before its device work was queued:
   /// the BVH's instances, the frame's preparation (RealtimeFrameData::Prepare) and any sky
-  /// upload (benchmarks); with late streaks without them (last_late_streaks_ms).
+  /// upload (benchmarks); without the late streaks (last_late_streaks_ms).
   double last_prepare_ms() const { return prepare_ms_; }
   /// host milliseconds the last realtime rgb frame spent making its late streaks while the GPU
   /// worked (RealtimeFrameData::PrepareStreaks; 0 without late streaks; benchmarks).
@@ -126,13 +116,15 @@ class CudaRenderer final : public Renderer {
   void RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* effects, const CameraView& view,
                  const PinholeCamera& camera, std::chrono::steady_clock::time_point t0,
                  RenderedFrame* out);
-  // the late streaks of a realtime frame (set_late_streaks): PrepareStreaks of the frame's
+  // the late streaks of a realtime frame: PrepareStreaks of the frame's
   // `snapshot`, `effects` and `view` (referenced: they outlive the Render that calls it), then
   // their fields into the device's frame (RealtimeFrameData::StreakFields); times itself
   // (last_late_streaks_ms) and its start from t0, when Render began (last_late_streaks_start_ms).
   DeviceRealtime::StreaksFn LateStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                                         const CameraView& view,
                                         std::chrono::steady_clock::time_point t0);
+  // sets realtime_'s device drop culler: DeviceStreakCull (drop_cull_) on the device's stream
+  void SetDeviceDropCuller();
   // after a realtime frame whose drops DeviceStreakCull::Queue culled (cull_queued_): its
   // counts read (DeviceStreakCull::Finish: the culled rain into realtime_, or its ConfigError)
   void FinishDropCulling();
@@ -166,8 +158,7 @@ class CudaRenderer final : public Renderer {
                                       // DevicePath::UploadMedia)
   EffectsFrame path_effects_;         // the frame's effects without media (EffectsWithoutMedia)
   std::unique_ptr<ThreadPool> pool_;  // the host's sky terms
-  std::unique_ptr<DeviceStreakCull> drop_cull_;  // the device's drop culling (device_culling)
-  bool device_culling_ = false;
+  std::unique_ptr<DeviceStreakCull> drop_cull_;  // the device's drop culling
   bool cull_queued_ = false;  // the frame's drops queued on drop_cull_, not yet Finished
   // the media volumes' shadow rays (RealtimeFrameData::PrepareMedia) over bvh_ and device_
   std::unique_ptr<CudaRayQuery> media_query_;
@@ -180,7 +171,6 @@ class CudaRenderer final : public Renderer {
   double prepare_ms_ = 0;
   double late_streaks_ms_ = 0;
   double late_streaks_start_ms_ = 0;
-  bool late_streaks_ = true;
   bool radiance_output_ = true;
   int64_t gpu_frames_ = 0;
 };
