@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # on a GPU machine, in an unpacked pack (scripts/gpu/pack.sh) or a build folder: prints the
-# parity table of the CUDA backend against the CPU backend (issue 35, item 7; docs/gpu.md
+# parity table of the CUDA backend against the CPU backend (docs/gpu.md
 # "Measured") for the default, house, warehouse and outdoor worlds and every worlds/effects/*.yaml:
 # the first camera at 320x240 after 1 s, depth within 1 mm %, segmentation equal %, same-depth
-# ties, whether the frame with the world's effects is on the GPU (every effect since branch
-# gpu12: lighting effects, particles, homogeneous and grid media, particles seen through media),
-# and the rgb PSNR of that frame (every frame renders on the GPU); then the pathtraced tier's row (issue 35:
+# ties, whether the frame with the world's effects is on the GPU (every effect: lighting effects,
+# particles, homogeneous and grid media, particles seen through media),
+# and the rgb PSNR of that frame (every frame renders on the GPU); then the pathtraced tier's row (target:
 # pathtraced at 1024 spp, mean relative difference <= 1 %): the default and house worlds' first
 # camera at 128x96 after 1 s, 1024 samples per pixel, the radiance's mean relative difference
 # between the GPU's and the CPU backend's (8x8 blocks and the image mean; render_cuda_bench

@@ -420,7 +420,7 @@ TEST(BatchRenderingEffects, LightingEffectsEqualCudaRendererAloneBitForBit) {
   EffectsFrame fog = *fx;
   fog.homogeneous_media.emplace_back();
   fog.homogeneous_media.back().sigma_t_per_m = Eigen::Vector3f::Constant(0.1f);
-  // media were refused here before branch gpu26; now that world's cameras are rendered alone
+  // a world with media: its cameras are rendered alone
   r.UpdateWorld(0, snap, &fog);
   const cuda::BatchImages foggy = r.Wait(r.Submit(cams));
   {

@@ -1,11 +1,11 @@
 #pragma once
-// the CUDA backend against the CPU backend on one world (issue 35, item 7): the world's first
+// the CUDA backend against the CPU backend on one world: the world's first
 // camera at `width` x `height` after 1 s of simulation, both backends built by MakeRenderer.
 // depth within 1 mm and segmentation equal are counted on the clear frame (no effects: the
 // geometry both backends trace); the rgb PSNR is that of the frame with the world's effects, if
-// it has any (every frame renders on the GPU: lighting effects since branch gpu6, particles
-// without media and homogeneous media since gpu10, grid media and particles seen through media
-// since gpu12, the pathtraced tier's media and particles since gpu14 and gpu16). shared by
+// it has any (every frame renders on the GPU: lighting effects, particles,
+// homogeneous and grid media, particles seen through media, the pathtraced tier's media and
+// particles). shared by
 // render_cuda_bench --parity
 // (scripts/gpu/parity.sh) and the `gpu` test CudaParity. header-only: both link the same libraries.
 

@@ -1,9 +1,9 @@
-// the parity of the CUDA backend with the CPU backend (issue 35, item 7; ctest label `gpu`) on
+// the parity of the CUDA backend with the CPU backend (ctest label `gpu`) on
 // the worlds cuda_backend_gpu_test.cc does not cover: the outdoor world and every
 // worlds/effects/*.yaml (cuda_parity.h, as scripts/gpu/parity.sh prints them): on the clear
 // frame depth within 1 mm on >= 99.9 % of pixels and segmentation equal on >= 99.9 % (same-depth
 // ties of coplanar geoms counted apart); where the frame with the world's effects renders on the
-// GPU (every effect since branch gpu12: lighting effects: blackout, flashlight, sun; particles:
+// GPU (every effect: lighting effects: blackout, flashlight, sun; particles:
 // rain, snow; homogeneous media: fog, height_fog, dust; grid media: smoke_plume, fire,
 // vdb_smoke; all of them with rain seen through media: adversity_major), its rgb PSNR >= 40 dB
 // against the CPU backend.

@@ -1,4 +1,4 @@
-// the lighting effects, particles and media on the GPU (ctest label `gpu`; issue 35 item 5): the
+// the lighting effects, particles and media on the GPU (ctest label `gpu`): the
 // frames of effects/blackout.yaml (in its power cut at 4 s), effects/flashlight.yaml,
 // effects/sun.yaml, effects/rain.yaml, effects/snow.yaml, the homogeneous media of
 // effects/fog.yaml, effects/height_fog.yaml and effects/dust.yaml, the grids of
@@ -8,11 +8,11 @@
 // 99.9 % of pixels against the CPU backend under the same EffectsFrame, two GPU renders
 // bit-identical; one renderer alternating the sun world's clear frame and its effects frame (the
 // sky rebuilt, the sky volume relit, the device sky uploaded again) gives each frame's bits every
-// time. the media volumes the device builds itself (the world light volume and the fog froxels,
-// branch gpu15; the grids' light volumes and froxels, branch gpu17) against the same volumes
+// time. the media volumes the device builds itself (the world light volume and the fog froxels;
+// the grids' light volumes and froxels) against the same volumes
 // built on the host and uploaded (RealtimeFrameData::set_device_media(false)): rgb PSNR >= 50
 // dB, depth equal, two device-built renders bit-identical; the grids' volumes themselves within
-// stated tolerances of the host's. the particle streaks splatted on the device (branch gpu18)
+// stated tolerances of the host's. the particle streaks splatted on the device
 // against the host splat of before (RealtimeFrameData::set_device_streaks(false)): the same
 // streak pixels and t, rgb within stated tolerances. without a device every test prints
 // "skipped: no CUDA device".
@@ -94,7 +94,7 @@ INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeEffectsGpu,
                                            GpuEffectsWorld{"effects/vdb_smoke.yaml", 1.0},
                                            GpuEffectsWorld{"effects/adversity_major.yaml", 1.0}));
 
-// the realtime particle streaks splatted and shaded on the device (branch gpu18, the default:
+// the realtime particle streaks splatted and shaded on the device (the default:
 // StreakSplatKernel, StreakShadeKernel) against the host splat of before in the same renderer
 // (RealtimeFrameData::set_device_streaks(false): the CPU's ParticleStreaks splat and shading,
 // their pixels uploaded), rain and snow (the rover's camera) and fire (sparks through the fire's

@@ -1,12 +1,12 @@
 // the lighting effects (light intensity scales, extra lights, the moved or scaled sky, surface
-// wetness; issue 35 item 5) on the CUDA backend's realtime rgb path, run on the CPU
+// wetness) on the CUDA backend's realtime rgb path, run on the CPU
 // (RenderRealtimeOnHost: the PB_HOST_DEVICE functions the kernels run), against the CPU
 // backend rendering the same EffectsFrame: the bundled worlds whose effects are only lighting
 // (effects/blackout.yaml at 1 s and in its power cut at 4 s, effects/flashlight.yaml,
 // effects/sun.yaml) and a hand-made frame with every lighting field set on the default room, at
 // 160x120: rgb PSNR >= 40 dB, depth within 1 mm on >= 99.9 % of pixels, two renders
 // bit-identical, and the effects change the image; the particle streaks of the rain and snow
-// worlds (the media: realtime_media_test.cc). every effect is on the GPU since branch gpu12.
+// worlds (the media: realtime_media_test.cc). every effect is on the GPU.
 // no GPU needed.
 
 #include <gtest/gtest.h>
@@ -165,7 +165,7 @@ TEST(RealtimeHostPathEffectsFrames, ParticleStreaksMatchCpuBackend) {
   }
 }
 
-// the realtime particle streaks splatted and shaded by the frame itself (branch gpu18, the
+// the realtime particle streaks splatted and shaded by the frame itself (the
 // default: StreakSplatView, here on the CPU by RenderRealtimeOnHost, the kernels' functions)
 // give the host splat's image (RealtimeFrameData::set_device_streaks(false): the CPU's
 // ParticleStreaks splat, PrecomputeRain and Shade, as before) byte for byte: rain and snow (the
@@ -238,7 +238,7 @@ TEST(RealtimeHostPathEffectsFrames, DeviceSplatGivesTheHostSplatsImageByteForByt
   }
 }
 
-// the late streaks (branch gpu23: CudaRenderer makes the frame's streaks while the GPU shades):
+// the late streaks (CudaRenderer makes the frame's streaks while the GPU shades):
 // Prepare without streaks, then PrepareStreaks after the media, gives the frame of a Prepare
 // with them to the bit (rgb, radiance, depth, EV100), rain and snow (the rover's camera,
 // shelter and rain culling) and fire (sparks through the fire's grid media, which PrepareMedia
@@ -300,11 +300,11 @@ TEST(RealtimeHostPathEffectsFrames, LateStreaksGiveTheSameBits) {
 // CPU's ParticleStreaks, each row at its own pose) with its t and coverage; the frame is the
 // host splat's byte for byte and matches the CPU backend's (rgb PSNR >= 40 dB, depth within 1 mm
 // on >= 99.9 % of pixels, the streak pixels' radiance within a tenth of their error without the
-// streaks). with the camera's float ray tables instead (PrimaryRay<true>, as before branch
-// gpu23) or the still camera's rays the keys are not the host's (the check can fail). the
-// splat's keys equal a brute force over every pixel's ray and every streak (branch gpu25: the
-// boxes widened by the rows' motion, each row's columns in its own pose); with the first row's
-// pose only (StreakSplatView::poses null, as before) they differ on most streak pixels.
+// streaks). with the camera's float ray tables instead (PrimaryRay<true>) or the still camera's
+// rays the keys are not the host's (the check can fail). the splat's keys equal a brute force over
+// every pixel's ray and every streak (the boxes widened by the rows' motion, each row's columns in
+// its own pose); with the first row's pose only (StreakSplatView::poses null, as before) they
+// differ on most streak pixels.
 TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) {
   auto [session, snap, view, fx] = realtime_parity::LoadFrameAt("effects/rain.yaml", 1.0, 160, 120);
   const SceneDescription& scene = session->scene();
@@ -361,7 +361,7 @@ TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) 
   const size_t bad = mismatch(keys, &keyed);
   // every pixel's nearest streak by brute force (each pixel's ray, SplatRay, against every
   // streak): the splat's keys exactly; the splat with the first row's pose only (no
-  // StreakSplatView::poses: its boxes and row columns before branch gpu25) misses some
+  // StreakSplatView::poses: its boxes and row columns of the first row's pose) misses some
   std::vector<unsigned long long> brute(static_cast<size_t>(W) * H, kNoStreakKey);
   for (int v = 0; v < H; ++v) {
     for (int u = 0; u < W; ++u) {
@@ -392,7 +392,7 @@ TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) 
       brute_keyed, brute_differ, first_differ);
   EXPECT_EQ(brute_differ, 0u);
   EXPECT_GT(first_differ, brute_keyed / 4);
-  // the frame's float ray tables instead of the double row poses (as before branch gpu23), and
+  // the frame's float ray tables instead of the double row poses (float rays), and
   // the still camera's rays
   cuda::RealtimeFrameView tables = f;
   tables.splat.rows = nullptr;

@@ -1,4 +1,4 @@
-// media (fog, haze, dust; smoke, fire and VDB grids; issue 35 item 5) on the CUDA backend's
+// media (fog, haze, dust; smoke, fire and VDB grids) on the CUDA backend's
 // realtime rgb path, run on the CPU (RenderRealtimeOnHost: the PB_HOST_DEVICE functions the
 // kernels run) against the CPU backend rendering the same EffectsFrame: the frames of
 // effects/fog.yaml, height_fog.yaml, dust.yaml, smoke_plume.yaml, fire.yaml, vdb_smoke.yaml and
@@ -8,8 +8,8 @@
 // is far from the CPU's image.
 // the media's volumes are built by RealtimeFrameData::PrepareMedia (the CPU's RealtimeMedia over
 // the host BVH's RayQuery), the world light volume and the fog froxels by the kernels' functions
-// on the host (BuildMediaVolumesOnHost, branch gpu15), which must give the host build's light
-// volume bit for bit and its fog froxels up to the column rays' rounding; since branch gpu17 the
+// on the host (BuildMediaVolumesOnHost), which must give the host build's light
+// volume bit for bit and its fog froxels up to the column rays' rounding; the
 // grids' light volumes and froxels too (bit for bit, and up to the column rays' rounding).
 // PENUMBRA_PARITY_SIZE=WxH changes the bundled worlds' 160x120 (e.g. 640x480, or an odd size whose
 // last quads are cut by the image's edge). no GPU needed.
@@ -129,7 +129,7 @@ TEST(RealtimeHostPathMediaFrames, MediaRaysAndShadingPathsGiveTheSameBits) {
 // the light volume's transmittances bit for bit (the same functions and shadow rays), the fog
 // froxels within 1e-4 of their largest value (the column rays are PrimaryRay's, not
 // Camera::GenerateRay's), the two frames' rgb within 50 dB; fog (visibility rays), smoke (grids
-// only: since branch gpu17 their volumes are the device's too, next test) and the major preset
+// only: their volumes are the device's too, next test) and the major preset
 // (both).
 TEST(RealtimeHostPathMediaFrames, DeviceBuiltVolumesMatchTheHostBuild) {
   for (const char* file :

@@ -33,7 +33,7 @@
 // the device-to-host copy rates, pinned and pageable.
 // --media [--size WxH]: for each world's effects frame with media (first camera at 1 s, WxH,
 // default 640x480), Render() of rgb+depth with the media volumes (the world light volume and fog
-// froxels since branch gpu15, the grids' light volumes and froxels since gpu17) built by the
+// froxels, the grids' light volumes and froxels) built by the
 // device's kernels (the default) and on the host
 // (RealtimeFrameData::set_device_media(false), as before), interleaved three times: frames/s,
 // the host's preparation (CudaRenderer::last_prepare_ms), RealtimeMedia::Build's host time and
@@ -560,7 +560,7 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
     view.intrinsics = CameraIntrinsics::FromFovy(width, height, cam.intrinsics.fovy_deg());
     view.near_m = cam.near_m;
     view.outputs[ImageKind::kRgb] = view.outputs[ImageKind::kDepth] = true;
-    // the world's effects at the snapshot (media included: on the GPU since branch gpu14)
+    // the world's effects at the snapshot (media included: on the GPU)
     const std::shared_ptr<const EffectsFrame> effects =
         world.session->effects().Evaluate(snap, view.X_WO.translation());
     const EffectsFrame* fx = effects.get();
@@ -576,7 +576,7 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
     const bool repeats = a.radiance.data == b.radiance.data && a.rgb.data == b.rgb.data;
     const double gpu_ms = 1e3 * TimeRenders(gpu.get(), snap, view, frames, fx);
     const double kernel_ms = g->device_path().TimeKernel(&g->device(), frames);
-    // the particle streaks (branch gpu16): their count, the host's BVH build of the last frame
+    // the particle streaks: their count, the host's BVH build of the last frame
     // and the host's whole preparation of it
     const cuda::PathStreakBuild& streaks = g->realtime_frame().path_streaks();
     if (!streaks.empty())
@@ -935,7 +935,7 @@ int Main(int argc, char** argv) {
           }
           // a rolling-shutter camera that turns 0.25 rad and moves 16 cm during its 30 ms
           // readout (realtime_parity::AddRollingShutter): the device splat, whose boxes and row
-          // columns follow the rows' poses since branch gpu25, and the host splat
+          // columns follow the rows' poses, and the host splat
           CameraView rolling = rgb;
           realtime_parity::AddRollingShutter(&rolling);
           rows.push_back({name, size,

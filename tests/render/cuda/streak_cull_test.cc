@@ -1,4 +1,4 @@
-// the drops' shared culling decision (render/streak_cull_math.h's StreakCullDrop, branch gpu27),
+// the drops' shared culling decision (render/streak_cull_math.h's StreakCullDrop),
 // which ParticleStreaks::Build and the CUDA backend's device culling (cuda_streak_cull.h) call,
 // on the CPU (no GPU needed): on every drop of the rain and snow frames at 1 s, 640x480, of the
 // rain frame in fog (realtime_parity::AddRainFog: a height fog and a box of haze, rain culled as
@@ -9,7 +9,7 @@
 // rounding forms (a distance summed (x + y) + z instead of Eigen's x + (y + z) changes some widened
 // radii), so the comparison can fail. RealtimeFrameData's device drop culler
 // (set_device_drop_culler: PrepareStreaks hands the decision's inputs to it and the splat reads
-// the streaks where it made them, their count there too, branch gpu30) fed by a host run of
+// the streaks where it made them, their count there too) fed by a host run of
 // StreakCullDrop with an in-order compaction, as the device's kernels do, in host memory, gives
 // the host culling's frame to the bit (rgb, radiance, depth, EV100), though its list holds more
 // places than streaks.
@@ -38,8 +38,8 @@ namespace {
 
 Eigen::Vector3f E(const Float3& f) { return Eigen::Vector3f(f.x, f.y, f.z); }
 
-// ParticleStreaks::Build's `drop` lambda (with its `outside` and RainInvisible) as it was
-// before branch gpu27, in Eigen, over the frame's decision inputs: the reference.
+// ParticleStreaks::Build's `drop` lambda (with its `outside` and RainInvisible) written
+// independently in Eigen, over the frame's decision inputs: the reference.
 int32_t ReferenceDrop(const StreakCullSetup& c, const Camera& camera, size_t s,
                       const Eigen::Vector3f& p, const Eigen::Vector3f& v, float r,
                       StreakCullOut* out) {
@@ -250,8 +250,8 @@ std::unique_ptr<HostCulledRain> RenderHostCulledRain(bool rolling) {
   return r;
 }
 
-// the streaks left where the culler made them (RealtimeFrameData::set_device_drop_culler,
-// branch gpu30: the CUDA backend's default, with device memory): a culler that returns a list of
+// the streaks left where the culler made them (RealtimeFrameData::set_device_drop_culler:
+// the CUDA backend's, with device memory): a culler that returns a list of
 // `bound` places (the device's: every drop's; here twice the streaks and one) of which only the
 // first *count are streaks, the rest other (wider, opaque) streaks, and its culled rain after
 // the frame (FinishDeviceCulling). here its

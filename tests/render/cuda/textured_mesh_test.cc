@@ -5,7 +5,7 @@
 //   the shading normal, texcoords, uv_per_m and duv_dp_G of Embree's RayScene;
 // - the realtime rgb of the GPU path on the host (RenderRealtimeOnHost) matches the CPU backend
 //   (rgb PSNR >= 40 dB, depth within 1 mm on >= 99.9 % of pixels), while the same path without
-//   them (flat, untextured: the GPU before branch gpu9) stays below 30 dB; the box in its cube
+//   them (flat, untextured) stays below 30 dB; the box in its cube
 //   texture and the skybox are in the frame too.
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 #pragma once
-// batch rendering on the GPU (issue 35, item 6; docs/gpu.md "Batch rendering"): the cameras of
+// batch rendering on the GPU (docs/gpu.md "Batch rendering"): the cameras of
 // one world, and the cameras of N independent worlds (N sessions in one process), rendered by
 // one kernel launch into one device buffer; the images copied back in one pinned transfer per
 // batch on a second stream, overlapped with the next batch's kernel, or left on the device for

@@ -1,4 +1,4 @@
-// the drops culled on the device (cuda_streak_cull.h, branch gpu27). compiled with -fmad=false
+// the drops culled on the device (cuda_streak_cull.h). compiled with -fmad=false
 // (CMakeLists.txt): no multiply-add is contracted where the host rounds twice.
 
 #include <algorithm>

@@ -1,5 +1,5 @@
 #pragma once
-// the drops of a frame's particle sets culled on the device (branch gpu27): one thread per drop
+// the drops of a frame's particle sets culled on the device: one thread per drop
 // runs the CPU's per-drop decision (render/streak_cull_math.h's StreakCullDrop, which
 // ParticleStreaks::Build calls too) and an order-keeping compaction (cub::DeviceScan's exclusive
 // sum over the kept flags, no atomics) writes the drawn streaks in the host's (set, index)
@@ -7,7 +7,7 @@
 // alpha, prim = the streak's index, set), so the streaks are the host culling's to the bit. the
 // culled rain is counted by cub::DeviceReduce::Sum and the first non-finite drop found by
 // cub::DeviceReduce::Min. Queue leaves the streaks and their count on the device for the
-// frame's splat (branch gpu30) and Finish reads the counts back later. the decision's file
+// frame's splat and Finish reads the counts back later. the decision's file
 // (cuda_streak_cull.cu) is compiled with -fmad=false and the shared functions round every
 // product and sum on their own (MulRn, AddRn) as well.
 
@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "penumbra/render/cuda/cuda_kernels.h"
-#include "penumbra/render/cuda/path_streaks.h"
 #include "penumbra/render/streak_cull_math.h"
+#include "penumbra/render/transport/path_streaks.h"
 
 namespace penumbra::cuda {
 
@@ -47,7 +47,7 @@ class DeviceStreakCull {
   void Run(const DropSet* sets, int32_t num_sets, const StreakCullFrame& frame,
            const StreakCullSet* flags, const ParallelFn& parallel = ParallelFn());
 
-  /// as Run without the wait (branch gpu30): the drops (copied into page-locked staging in
+  /// as Run without the wait: the drops (copied into page-locked staging in
   /// chunks over `parallel`, may be empty: serially), the sets' flags and the media go over in
   /// one transfer, the roof only when the map changed (ShelterPod's pointer, size or version),
   /// and the decision, the compaction and the copy back of the counts (streaks, culled rain,

@@ -1,7 +1,7 @@
 #pragma once
 // the grid media's arrays (render/media_scene_math.h's MediaGridPod: densities and emission)
-// copied to the device, for the pathtraced kernels (DevicePath::UploadMedia, branch gpu14) and
-// the realtime tier's grid volume kernels (DeviceRealtime, branch gpu17). includes the CUDA
+// copied to the device, for the pathtraced kernels (DevicePath::UploadMedia) and the
+// realtime tier's grid volume kernels (DeviceRealtime). includes the CUDA
 // runtime header (cuda_device_buffer.h): only .cu files include this.
 
 #include <cuda_runtime.h>

@@ -1,8 +1,8 @@
 #pragma once
 // a frame's particle streaks (path_streaks.h's PathStreaks: the BVH's nodes where it has one, the
 // StreakPods, their particle sets, the rain's radiance where precomputed) copied to the device,
-// for the pathtraced kernels (DevicePath::UploadStreaks, branch gpu16) and the realtime tier's
-// splat (DeviceRealtime::Render, StreakSplatView, branch gpu18). includes the CUDA runtime header
+// for the pathtraced kernels (DevicePath::UploadStreaks) and the realtime tier's splat
+// (DeviceRealtime::Render, StreakSplatView). includes the CUDA runtime header
 // (cuda_device_buffer.h): only .cu files include this.
 
 #include <cuda_runtime.h>
@@ -10,7 +10,7 @@
 #include <cstring>
 
 #include "penumbra/render/cuda/cuda_device_buffer.h"
-#include "penumbra/render/cuda/path_streaks.h"
+#include "penumbra/render/transport/path_streaks.h"
 
 namespace penumbra::cuda {
 
@@ -37,7 +37,7 @@ struct StreakBuffers {
   }
 
   /// h's particle sets copied on `stream`, its streaks already on the device (the device
-  /// culling's, read in place: StreakSplatView::count, branch gpu30; no BVH, no rain): through
+  /// culling's, read in place: StreakSplatView::count; no BVH, no rain): through
   /// the page-locked *pin (grown as needed; not written again before the copy is done) when
   /// pin is not null, else from h's pageable array (staged before the call returns). returns h
   /// with the sets' device pointer (num: h's, a bound).
