@@ -26,7 +26,7 @@ for k in $(seq 1 "$repeats"); do
   step base_$k 70 "$B/base_bench" --realtime --frames 30 "$W/default.yaml" "$W/house.yaml"
   step new_$k 70 "$B/render_cuda_bench" --realtime --frames 30 "$W/default.yaml" "$W/house.yaml"
 done
-[ "${AB_TESTS:-1}" = 1 ] && step tests 150 "$B/render_cuda_gpu_tests" --gtest_filter='*RealtimeSpeedUps*:*RealtimeRgbGpu*'
+[ "${AB_TESTS:-1}" = 1 ] && step tests 150 "$B/render_cuda_gpu_tests" --gtest_filter='*RealtimeRgbGpu*:*RealtimeExposure*'
 NCU=$(command -v ncu || ls /usr/local/cuda/bin/ncu 2>/dev/null | head -1)
 if [ -n "$NCU" ]; then
   for who in ${AB_NCU:-new base}; do

@@ -51,7 +51,7 @@ summary() {
   for f in "$L"/rt_base_*.txt "$L"/rt_new_*.txt; do
     [ -f "$f" ] || continue
     echo "-- $(basename "$f")"
-    grep -E '^\| (default|house)' "$f" | grep -E 'radiance in 2 bands copies \||FNV|bit-identical|kernels, all speed-ups|developed again' | cut -c1-160
+    grep -E '^\| (default|house)' "$f" | grep -E 'cuda Render\(\) \||radiance in 2 bands copies \||FNV|bit-identical|\| kernels \||kernels, all speed-ups|developed again' | cut -c1-160
   done
   echo; echo "== where Render()'s time goes (this pack)"
   for f in "$L"/rt_new_1.txt "$L"/rt128_new.txt; do

@@ -199,10 +199,6 @@ TEST_F(BatchRendering, TwoRunsGiveTheSameBits) {
     else
       EXPECT_TRUE(bytes == first) << "two runs of the same batch differ";
   }
-  // pageable copies give the same bits as pinned ones
-  cuda::BatchRenderer pageable(AllTruth(8, cuda::BatchCopy::kPageable));
-  AddWorlds(&pageable);
-  EXPECT_TRUE(BatchBytes(pageable.Wait(pageable.Submit(cams))) == first);
 }
 
 TEST_F(BatchRendering, OverlappedBatchesKeepTheirOwnImages) {

@@ -27,10 +27,10 @@
 // and the BVH build time. prints one markdown table.
 // --batch N[,N...] [--size WxH] [--sessions S]: batch rendering instead (cuda_batch_bench.h):
 // batches of N cameras over S sessions of each world (default 1) at WxH (default 128x128),
-// depth+seg and then realtime rgb+depth (with each realtime stage's GPU time), pinned and
-// pageable copies, the kernels alone and the CPU backend, each world under its effects at 1 s
-// (a world with particles or media: its rgb cameras rendered alone, with their host time); then
-// the device-to-host copy rates, pinned and pageable.
+// depth+seg and then realtime rgb+depth (with each realtime stage's GPU time), the copies
+// overlapped with the next batch, the kernels alone and the CPU backend, each world under its
+// effects at 1 s (a world with particles or media: its rgb cameras rendered alone, with their host
+// time); then the device-to-host copy rates, pinned and pageable.
 // --media [--size WxH]: for each world's effects frame with media (first camera at 1 s, WxH,
 // default 640x480), Render() of rgb+depth with the media volumes (the world light volume and fog
 // froxels, the grids' light volumes and froxels) built by the

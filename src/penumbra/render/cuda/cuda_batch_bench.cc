@@ -107,13 +107,13 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
   std::vector<BatchBenchRow> rows;
   int max_cameras = 1;
   for (int k : camera_counts) max_cameras = std::max(max_cameras, k);
-  for (const BatchCopy copy : {BatchCopy::kPinned, BatchCopy::kPageable}) {
+  {
     BatchConfig config;
     config.width = width;
     config.height = height;
     config.max_cameras = max_cameras;
     config.outputs = outputs;
-    config.copy = copy;
+    config.copy = BatchCopy::kPinned;
     config.statics_query = statics_query;
     BatchRenderer r(config);
     for (const BatchBenchWorld& w : worlds) {
@@ -133,14 +133,10 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
       int alone = 0;
       RealtimeBatchTimes st;
       const double s = TimePipeline(&r, cams, batches, &kernel_ms, &st, &alone_ms, &alone);
-      const bool pinned = copy == BatchCopy::kPinned;
-      rows.push_back({count, "cuda",
-                      pinned ? "batch, pinned copy overlapped" : "batch, pageable copy", count / s,
-                      1e3 * s});
-      if (pinned)
-        rows.push_back({count, "cuda", "kernel only", count / (kernel_ms * 1e-3), kernel_ms});
+      rows.push_back({count, "cuda", "batch, pinned copy overlapped", count / s, 1e3 * s});
+      rows.push_back({count, "cuda", "kernel only", count / (kernel_ms * 1e-3), kernel_ms});
       // where an rgb batch's GPU time goes: frames/s if the batch were that stage alone
-      if (pinned && outputs.rgb) {
+      if (outputs.rgb) {
         const std::pair<const char*, double> stages[] = {
             {"stage: geometry", st.geometry},   {"stage: sky terms", st.sky},
             {"stage: shading", st.shade},       {"stage: shared visibility", st.visibility},

@@ -1,7 +1,7 @@
 #pragma once
 // the batch-rendering benchmark shared by `penumbra bench render --batch N` (bench/bench.cc) and
 // render_cuda_bench (scripts/gpu/check.sh): K cameras spread over N worlds rendered by
-// BatchRenderer, with pinned and with pageable copies back, the kernel alone, and the CPU
+// BatchRenderer, its copies back overlapped with the next kernel, the kernel alone, and the CPU
 // backend rendering the same views one by one. a benchmark, never a pass/fail test.
 
 #include <span>
@@ -53,7 +53,7 @@ std::vector<CameraView> BatchBenchViews(std::span<const BatchBenchWorld> worlds,
 
 /// times batches of each count of `camera_counts` (width x height, `outputs`): `batches`
 /// batches each with pinned copies overlapped with the next kernel (wall clock from the first
-/// Submit to the last Wait), the same with pageable copies, the kernel alone (CUDA events;
+/// Submit to the last Wait), the kernel alone (CUDA events;
 /// with rgb all the batch's kernels, its exposures included), with rgb each realtime
 /// stage's GPU time (rows "stage: ..."; RealtimeBatchTimes), with rgb and cameras rendered
 /// alone (worlds with PerCameraEffects) the host time of those (row "cameras rendered alone",

@@ -11,8 +11,8 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/cuda/cuda_batch_kernels.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
-#include "penumbra/render/cuda/primary_pixel.h"
-#include "penumbra/render/cuda/realtime_shading.h"
+#include "penumbra/render/transport/primary_pixel.h"
+#include "penumbra/render/transport/realtime.h"
 
 namespace penumbra::cuda {
 namespace {
@@ -75,12 +75,7 @@ struct BatchDevice::Impl {
       if (cameras[s]) cudaFree(cameras[s]);
       if (views[s]) cudaFree(views[s]);
       if (tables[s]) cudaFree(tables[s]);
-      if (host[s]) {
-        if (copy == BatchCopy::kPinned)
-          cudaFreeHost(host[s]);
-        else
-          delete[] host[s];
-      }
+      if (host[s]) cudaFreeHost(host[s]);
       for (cudaEvent_t e : {started[s], done[s], copied[s]})
         if (e) cudaEventDestroy(e);
     }
@@ -105,8 +100,6 @@ BatchDevice::BatchDevice(const BatchLayout& layout, BatchCopy copy) : impl_(new 
       if (copy == BatchCopy::kPinned)
         CheckBatch(cudaMallocHost(reinterpret_cast<void**>(&m.host[s]), bytes),
                    "cudaMallocHost (pinned images)");
-      else if (copy == BatchCopy::kPageable)
-        m.host[s] = new uint8_t[bytes];
       CheckBatch(cudaEventCreate(&m.started[s]), "cudaEventCreate");
       CheckBatch(cudaEventCreate(&m.done[s]), "cudaEventCreate");
       CheckBatch(cudaEventCreateWithFlags(&m.copied[s], cudaEventDisableTiming), "cudaEventCreate");

@@ -9,16 +9,15 @@
 #include <cstdint>
 #include <functional>
 
+#include "penumbra/render/bvh/bvh_types.h"
 #include "penumbra/render/cuda/batch_layout.h"
-#include "penumbra/render/cuda/bvh_types.h"
 
 namespace penumbra::cuda {
 
 /// where a batch's images go after its kernel.
 enum class BatchCopy {
-  kPinned,    ///< copied back into page-locked host memory, asynchronously (the default)
-  kPageable,  ///< copied back into ordinary host memory (the driver stages it: slower)
-  kNone,      ///< left on the device for a consumer on the GPU (device-pointer API)
+  kPinned,  ///< copied back into page-locked host memory, asynchronously (the default)
+  kNone,    ///< left on the device for a consumer on the GPU (device-pointer API)
 };
 
 /// the streams, events and per-slot buffers of batch rendering (BatchTickets::kSlots slots).
