@@ -4,7 +4,7 @@
 // (camera-like ray fans). the hit distance within 1e-4 relative and the geom equal on >= 99.9 %
 // of the rays (triangle edges may go either way between two float triangle tests).
 
-#include "penumbra/render/cuda/bvh_traversal.h"
+#include "penumbra/render/bvh/bvh_traversal.h"
 
 #include <gtest/gtest.h>
 
@@ -717,7 +717,7 @@ TEST_P(CudaBvhWorlds, OcclusionThroughTheTopLevelGivesTheFlatListsVerdicts) {
     const cuda::SceneView s = bvh.view();
     ASSERT_NE(s.tlas_instances, nullptr);
     cuda::SceneView flat = s;
-    flat.occlusion_tlas = 0;
+    flat.tlas_instances = nullptr;  // no top level: the flat loop
     cuda::SceneView stale = s;
     stale.tlas_nodes = old_nodes.empty() ? nullptr : old_nodes.data();
     stale.tlas_instances = old_instances.data();
@@ -797,7 +797,7 @@ int InstancesHittingAt(const cuda::SceneView& s, const cuda::TraceRay& r, float 
     cuda::SceneView one = s;
     one.instances = s.instances + i;
     one.num_instances = 1;
-    one.closest_tlas = 0;
+    one.tlas_instances = nullptr;
     cuda::TraceHit h;
     cuda::TraceClosest(one, r, &h);
     n += h.instance == 0 && std::memcmp(&h.t, &t, sizeof(float)) == 0;
@@ -806,7 +806,7 @@ int InstancesHittingAt(const cuda::SceneView& s, const cuda::TraceRay& r, float 
 }
 
 // TraceClosest through the top level (BuildBvh's and the one with reversed leaves) against the
-// flat loop (closest_tlas 0), and the variants of its tie rule (ClosestTies).
+// flat loop (no top level), and the variants of its tie rule (ClosestTies).
 struct ClosestComparison {
   int64_t rays = 0, hits = 0, ties = 0;
   int64_t differ = 0, reversed_differ = 0;         // must stay 0
@@ -814,7 +814,7 @@ struct ClosestComparison {
 
   void Add(const cuda::SceneView& s, const cuda::SceneView& reversed, const cuda::TraceRay& r) {
     cuda::SceneView flat = s;
-    flat.closest_tlas = 0;
+    flat.tlas_instances = nullptr;
     cuda::TraceHit want, got, rev, next_up[2], no_rule[2];
     cuda::TraceClosest(flat, r, &want);
     cuda::TraceClosest(s, r, &got);
@@ -853,8 +853,8 @@ class CudaBvhClosestWorlds : public CudaBvhWorlds {};
 // the top level), and with the moving bodies piled up four by four at one pose each, where
 // equal shapes (the crowd's people) and the bodies' shared planes give ties between instances;
 // also through a top level whose leaves list their instances the other way round. the variants
-// of the tie rule show the comparison can fail (the counts are in docs/gpu.md, "Closest hits
-// through the top level (branch gpu36)").
+// of the tie rule show the comparison can fail (the counts are in
+// docs/journal/2026-11-26-gpu-speed.md, "Closest hits through the top level").
 TEST_P(CudaBvhClosestWorlds, ClosestThroughTheTopLevelGivesTheFlatLoopsHits) {
   Posed posed = LoadPosed();
   const cuda::BvhScene& bvh = posed.bvh->bvh();
@@ -904,8 +904,8 @@ INSTANTIATE_TEST_SUITE_P(Bundled, CudaBvhClosestWorlds,
 // faces, with rays in the shared planes (the edges' hits of two instances a few floats apart).
 // through the top level (BuildBvh's, and with its leaves reversed) every hit is the flat loop's;
 // without the tie rule (ClosestTies::kNone) and with a bound one float above the best t
-// (kNextUp) hits differ (the counts are in docs/gpu.md, "Closest hits through the top level
-// (branch gpu36)").
+// (kNextUp) hits differ (the counts are in
+// docs/journal/2026-11-26-gpu-speed.md, "Closest hits through the top level").
 TEST(CudaBvhTraversal, ClosestThroughTheTopLevelKeepsTheLowerInstanceOnATie) {
   SceneDescription scene = testing::EmptyScene();
   using testing::AddGeom;

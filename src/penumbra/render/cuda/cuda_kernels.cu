@@ -216,8 +216,6 @@ void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_vers
       tlas ? reinterpret_cast<const int32_t*>(device_instances + instance_bytes + tlas_node_bytes)
            : nullptr;
   m.view.tlas = v.tlas;
-  m.view.occlusion_tlas = v.occlusion_tlas;
-  m.view.closest_tlas = v.closest_tlas;
   if (wait) Check(cudaStreamSynchronize(m.stream), "uploading the scene");
 }
 
