@@ -127,8 +127,8 @@ void ExpRnOnDevice(const float* x, float* y, int64_t n) {
 DeviceScene::DeviceScene() : impl_(new Impl) {
   InitRuntime();
   try {
-    // the highest priority: the realtime frame's side stream (RealtimeKernelOptions::
-    // mirror_low_priority) runs below it
+    // the highest priority: the realtime frame's side stream (the mirror layer's, of the lowest
+    // priority) runs below it
     int least = 0, greatest = 0;
     Check(cudaDeviceGetStreamPriorityRange(&least, &greatest), "cudaDeviceGetStreamPriorityRange");
     Check(cudaStreamCreateWithPriority(&impl_->stream, cudaStreamDefault, greatest),
