@@ -2,7 +2,7 @@
 // the scalar BSDF of the pathtraced tier (render/bsdf.h: the glTF 2.0 metallic-roughness BRDF in
 // a local shading frame, with its lobe choice, visible-normal sampling and one-sample mixture
 // density) as PB_HOST_DEVICE functions over plain data: the CPU's Bsdf class and the CUDA
-// backend's path kernels (render/cuda/path_shading.h) call these, so the formulas exist once.
+// backend's path kernels (render/transport/path_trace.h) call these, so the formulas exist once.
 // the references and the model are documented in bsdf.h.
 //
 // bit-for-bit rule (render/shading_math.h): every expression keeps the operation order of the

@@ -3,7 +3,7 @@
 // plain data (docs/gpu.md, "One shading code"): the CPU's MediaScene builds a MediaSceneView
 // over its own arrays and its members call these (At, Transmittance, Track, MediumPoint's Phase
 // and SamplePhase, GridVolume's DensityAt / EmissionAt / Interval), and the CUDA backend's path
-// kernels (render/cuda/path_shading.h) call the same definitions over device copies of the
+// kernels (render/transport/path_trace.h) call the same definitions over device copies of the
 // arrays.
 //  - SampleHenyeyGreensteinDir: the Henyey-Greenstein phase function's sampling (render/
 //    media_common.h's SampleHenyeyGreenstein calls it; the function itself is MediaPhaseHG);

@@ -2,7 +2,7 @@
 // smooth shading and texture coordinates at a triangle hit, written once for both backends
 // (docs/gpu.md, "One shading code"): RayScene::FinishHit (render/embree/ray_scene.cc) mixes a
 // mesh's vertex normals and texcoords with it on the CPU, the CUDA backend's HitShadingNormal
-// and HitTexcoords (render/cuda/primary_pixel.h) on the GPU and in BvhScene::FinishHit.
+// and HitTexcoords (render/transport/primary_pixel.h) on the GPU and in BvhScene::FinishHit.
 // C++17, Eigen-free.
 
 #include "penumbra/core/host_device.h"

@@ -1,7 +1,7 @@
 #pragma once
 // the pathtraced tier's light terms as PB_HOST_DEVICE functions over plain data, shared by the
 // CPU's PathIntegrator (render/cpu/path_integrator.cc) and the CUDA backend's path kernels
-// (render/cuda/path_shading.h): the power heuristic of multiple importance sampling, the lamp
+// (render/transport/path_trace.h): the power heuristic of multiple importance sampling, the lamp
 // spheres (point and spot lights with a radius that cast shadows: their radiance, solid angle
 // and ray intersection) and the sun discs (directional lights with an angular radius). the
 // model is documented in render/cpu/path_integrator.h. every expression keeps the operation

@@ -8,7 +8,7 @@
 // (same geom, normals within 25 degrees, within 5 % of their distance from its tangent plane),
 // the window cut at the edges of the renderer's 16x16 pixel tiles. render/cpu/
 // realtime_integrator.cc (ResolveSharedVisibility) and the CUDA path
-// (render/cuda/realtime_shading.h, SharedVisibility*) apply it.
+// (render/transport/realtime_visibility.h, SharedVisibility*) apply it.
 
 #include <cstdint>
 

@@ -1,7 +1,7 @@
 #pragma once
 // SkyModel's importance sampling of the sky (render/sky_model.h: Sample and Pdf) over plain
 // data, shared by the CPU's SkyModel and the CUDA backend's path kernels
-// (render/cuda/path_shading.h). the tables: a piecewise-constant 2d distribution over cells of
+// (render/transport/path_trace.h). the tables: a piecewise-constant 2d distribution over cells of
 // the sphere, rows in theta (from +z) and columns in phi (from +x towards +y), with density
 // proportional to the sky's luminance times sin(theta) (Pharr, Jakob, Humphreys, "Physically
 // Based Rendering", 3rd ed., sec. 13.3.1 and 14.2.4); each 1d distribution has a guide table

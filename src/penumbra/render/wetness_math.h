@@ -1,7 +1,7 @@
 #pragma once
 // surface wetness of the rain effects (EffectsFrame::surface_wetness) as one PB_HOST_DEVICE
 // formula for both backends (docs/gpu.md, "One shading code"): the CPU's ApplySurfaceWetness
-// (material_eval.h) and the CUDA realtime path's EvaluateSurface (render/cuda/realtime_shading.h)
+// (material_eval.h) and the CUDA realtime path's EvaluateSurface (render/transport/surface.h)
 // call it. Lagarde, "Water drop 2a - Dynamic rain and its effects" and "Water drop 2b", 2013:
 // wet porous surfaces absorb more light (diffuse albedo x lerp(1, 0.3, w')) and a water film
 // makes them glossier (gloss = 1 - roughness, times lerp(1, 2.5, w'), capped at 1). w' = w s,

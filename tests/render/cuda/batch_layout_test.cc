@@ -1,7 +1,7 @@
 // batch rendering's host-side bookkeeping (render/cuda/batch_layout.h): where each camera's
 // image of each output lies in a batch's buffer, the checks of a batch's cameras (errors name
 // the camera and the field), and the ring of slots whose images stay readable; and the pixel's
-// ground truth (render/cuda/primary_pixel.h, the PB_HOST_DEVICE code the batch kernel runs)
+// ground truth (render/transport/primary_pixel.h, the PB_HOST_DEVICE code the batch kernel runs)
 // run on the CPU over the default world's BvhScene against the CPU backend's images; which
 // worlds' effects make a batch render their rgb cameras alone (PerCameraEffects: particles and
 // media, not the lighting effects).
@@ -20,7 +20,7 @@
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/cuda/bvh_scene.h"
-#include "penumbra/render/cuda/primary_pixel.h"
+#include "penumbra/render/transport/primary_pixel.h"
 #include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"

@@ -1,9 +1,7 @@
 // the pathtraced tier on the GPU (ctest label `gpu`) against the CPU backend on the bundled
 // default and house worlds, the default room with emissive lamp diffusers and with a distorted,
-// moving camera, and the effects worlds with media (fog, smoke_plume) and particles (rain, snow)
-// (issue 35, item 7:
-// pathtraced at 1024 spp, mean relative difference
-// <= 1 %): the first camera at 128x96 after 1 s, 1024 samples per pixel, 4 bounces, no denoiser;
+// moving camera, and the effects worlds with media (fog, smoke_plume) and particles (rain, snow):
+// the first camera at 128x96 after 1 s, 1024 samples per pixel, 4 bounces, no denoiser;
 // the radiance's mean relative difference at the scale of 8x8 blocks and of the image mean
 // (path_parity.h) <= 1 %, the frame rendered on the GPU (not the CPU fallback), and two GPU
 // renders bit-identical (radiance and rgb). without a device every test prints "skipped: no CUDA
@@ -85,7 +83,7 @@ INSTANTIATE_TEST_SUITE_P(Bundled, PathtracedGpu,
                          ::testing::Values("default.yaml", "house.yaml", "default-emissive.yaml",
                                            "default-distorted-moving.yaml"));
 
-// the pathtraced tier's media on the GPU (branch gpu14; path_shading.h's TracePath<true> over
+// the pathtraced tier's media on the GPU (render/transport/path_trace.h's TracePath<true> over
 // the shared formulas of render/media_scene_math.h): worlds/effects/fog.yaml (homogeneous fog,
 // the rover's camera) and smoke_plume.yaml (a smoke grid, the overview camera, which sees the
 // plume) at 1 s, 128x96, 1024 spp, 4 bounces, no denoiser, against the CPU backend on all
@@ -115,7 +113,7 @@ INSTANTIATE_TEST_SUITE_P(Effects, PathtracedGpuMedia,
                          ::testing::Values(std::make_pair(std::string("fog.yaml"), 0),
                                            std::make_pair(std::string("smoke_plume.yaml"), 1)));
 
-// the pathtraced tier's particles on the GPU (branch gpu16; path_streaks.h: the camera rays
+// the pathtraced tier's particles on the GPU (render/transport/path_streaks.h: the camera rays
 // meet the frame's streaks through a BVH, one draw against the streak's coverage, its radiance
 // from ShadeStreak): worlds/effects/rain.yaml and snow.yaml (the rover's camera) at 1 s, 128x96,
 // 1024 spp, 4 bounces, no denoiser, against the CPU backend on all cores: the radiance's mean

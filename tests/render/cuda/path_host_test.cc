@@ -23,10 +23,10 @@
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/path_frame.h"
-#include "penumbra/render/cuda/path_streaks.h"
 #include "penumbra/render/emitter_sampler.h"
 #include "penumbra/render/media_scene.h"
 #include "penumbra/render/particle_math.h"
+#include "penumbra/render/transport/path_streaks.h"
 #include "realtime_parity.h"
 
 namespace penumbra {
@@ -36,7 +36,7 @@ namespace {
 // of every shared formula, so it tracks the CPU's estimate closely: what differs is where the BVH
 // and Embree round a hit's distance and normal, after which a path may branch differently.
 // measured: default 0.0000 %, house 0.23 % (without the sky 18.6 % and 88.2 %, without the
-// lights 81.4 % and 16.8 %): issue 35's 1 %.
+// lights 81.4 % and 16.8 %): the bound is 1 %.
 constexpr double kHostTileTolerance = 0.01;
 
 struct HostPathtraced {
@@ -286,10 +286,10 @@ INSTANTIATE_TEST_SUITE_P(Effects, PathtracedHostMedia,
 // test of every streak (same nearest streak and t, bit for bit) on the camera's rays, and its
 // host build time is printed.
 // the streaks change these 64x48 frames by 0.23 % (fire's few sparks) to 0.80 % (snow) at the
-// block scale, below issue 35's 1 %: the tolerance here is the host path's own, 0.05 % (measured
-// 0.003 % to 0.007 %: the host path rounds as the CPU and draws its random numbers, so only
-// where Embree's round curves and the capsule test, or Embree and the BVH, round a hit apart do
-// the paths differ), which the same paths without the streaks exceed four times over.
+// block scale, below the 1 % of the GPU tests: the tolerance here is the host path's own, 0.05 %
+// (measured 0.003 % to 0.007 %: the host path rounds as the CPU and draws its random numbers, so
+// only where Embree's round curves and the capsule test, or Embree and the BVH, round a hit apart
+// do the paths differ), which the same paths without the streaks exceed four times over.
 constexpr double kHostParticleTolerance = 0.0005;
 
 class PathtracedHostParticles : public ::testing::TestWithParam<std::pair<std::string, int>> {};
@@ -366,7 +366,7 @@ INSTANTIATE_TEST_SUITE_P(Effects, PathtracedHostParticles,
                                            std::make_pair(std::string("fire.yaml"), 1)));
 
 // the realtime tier's media volumes are not built for the paths: Prepare gets the effects
-// without their media (the path kernels trace the media themselves, since branch gpu14).
+// without their media (the path kernels trace the media themselves).
 TEST(EffectsWithoutMedia, DropsTheMediaAndKeepsTheRest) {
   EffectsFrame fog;
   fog.homogeneous_media.emplace_back();

@@ -2,7 +2,7 @@
 // PB_HOST_DEVICE per-pixel functions the kernels run, over the host BVH), against the CPU
 // backend on the bundled default, house, warehouse and outdoor worlds and effects/walkers.yaml
 // (its rover's mirror materials, reflectance 0.2 and 0.4: the mirror layer) at 160x120: rgb PSNR
-// >= 40 dB (issue 35's mark; the `gpu` test RealtimeRgbGpu checks it at 640x480 on the GPU)
+// >= 40 dB (the `gpu` test RealtimeRgbGpu checks it at 640x480 on the GPU)
 // and depth within 1 mm on >= 99.9 % of pixels; two renders are bit-identical. no GPU needed.
 
 #include <gtest/gtest.h>
@@ -341,8 +341,8 @@ TEST(RealtimeHostPathFrames, SkyTermsInBandsEqualTheWholeFrame) {
 }
 
 // the window's sums in integers (SharedWindowFraction over ShadowWindowCounts, packed at each
-// tap or once into a tile's copy) against the float sums written out here (main's form before
-// branch gpu28: the window's bits in order, w ShadowWindowWeight, neighbours without a verdict
+// tap or once into a tile's copy) against the float sums written out here (the plain
+// form: the window's bits in order, w ShadowWindowWeight, neighbours without a verdict
 // left out): the same bits for 200,000 random windows and counts (traced 1 to 64, visible 0 to
 // traced, a quarter of the neighbours without a verdict), and for the tile ring's own fraction.
 TEST(RealtimeHostPathFrames, WindowSumsInIntegersGiveTheFloatSumsBits) {
@@ -392,8 +392,8 @@ TEST(RealtimeHostPathFrames, WindowSumsInIntegersGiveTheFloatSumsBits) {
   EXPECT_GT(fractions_seen, 100000);  // the fractions vary: not a comparison of constants
 }
 
-// the staged window of RealtimeKernelOptions::staged_window against main's forms written out
-// here (before branch gpu32): on random 16x16 tiles (cut to 9 .. 16 columns and rows, as the
+// the staged window of RealtimeKernelOptions::staged_window against the unstaged forms written out
+// here: on random 16x16 tiles (cut to 9 .. 16 columns and rows, as the
 // image's edges cut them) of surfaces and of one light's verdicts (-1, 0, 1; a third of the
 // tiles all visible but for misses), every pixel's window mask over the tile's copied surfaces
 // (TileWindowSurfaces) is the mask read from the PixelGeometry records (the old loop:

@@ -1,7 +1,7 @@
 #pragma once
 // helpers of the realtime rgb parity tests (host: realtime_host_test.cc; GPU:
 // realtime_rgb_gpu_test.cc): a bundled world after 1 s of simulation, its first camera's view,
-// and the image comparisons of issue 35 (rgb PSNR, depth within 1 mm).
+// and the image comparisons (rgb PSNR, depth within 1 mm).
 
 #include <cmath>
 #include <cstdint>
@@ -80,7 +80,7 @@ inline void AddRollingShutter(CameraView* view) {
       Eigen::AngleAxisd(0.25, Eigen::Vector3d::UnitZ()).toRotationMatrix() * view->X_WO.linear();
 }
 
-/// adds two homogeneous media to *fx (rain in fog, branch gpu27's culling tests): a height fog
+/// adds two homogeneous media to *fx (rain in fog, for the culling tests): a height fog
 /// over the whole world (sigma_t 0.3 / 0.35 / 0.4 per m below z = 0, falling off by 0.2 per m
 /// above) and a haze in the 20 m box around the world's origin (0.2 per m), so rain streaks a
 /// few metres away are culled as invisible (kRainCullContrast).

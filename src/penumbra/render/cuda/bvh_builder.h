@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/cuda/bvh_types.h"
+#include "penumbra/render/bvh/bvh_types.h"
 
 namespace penumbra::cuda {
 

@@ -2,7 +2,7 @@
 
 #include <memory>
 
-#include "penumbra/render/cuda/bvh_traversal.h"
+#include "penumbra/render/bvh/bvh_traversal.h"
 
 namespace penumbra::cuda {
 

@@ -1,5 +1,5 @@
 #pragma once
-// the CUDA backend's traversal (render/cuda/bvh_traversal.h) run on the CPU as a RayQuery: the
+// the CUDA backend's traversal (render/bvh/bvh_traversal.h) run on the CPU as a RayQuery: the
 // same PB_HOST_DEVICE code the GPU kernels run, so the tests check the backend's geometry
 // against Embree's RayScene on machines without a GPU. one thread; for the tests and as the
 // reference of the GPU query, not for speed.

@@ -9,8 +9,8 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/analytic_shapes.h"
-#include "penumbra/render/cuda/bvh_traversal.h"
-#include "penumbra/render/cuda/primary_pixel.h"
+#include "penumbra/render/bvh/bvh_traversal.h"
+#include "penumbra/render/transport/primary_pixel.h"
 #include "penumbra/render/static_geometry.h"
 #include "penumbra/render/triangle_shapes.h"
 
@@ -437,7 +437,7 @@ void BvhScene::FinishHit(const Ray& ray, const TraceHit& th, SurfaceHit* hit) co
   hit->ng_W = ng_W;
   hit->ns_W = ng_W;
   if (pr.kind != 0) return;
-  // smooth shading and texcoords (render/cuda/primary_pixel.h, as the GPU shades them)
+  // smooth shading and texcoords (render/transport/primary_pixel.h, as the GPU shades them)
   const SceneView v = view();
   Float3 ns;
   if (HitShadingNormal(v, th, hit->front_face, &ns)) hit->ns_W = Eigen::Vector3f(ns.x, ns.y, ns.z);

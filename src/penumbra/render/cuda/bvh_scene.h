@@ -20,7 +20,7 @@
 
 #include "penumbra/core/pose.h"
 #include "penumbra/render/cuda/bvh_builder.h"
-#include "penumbra/render/cuda/bvh_types.h"
+#include "penumbra/render/bvh/bvh_types.h"
 #include "penumbra/render/ray.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"

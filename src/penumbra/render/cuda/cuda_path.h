@@ -1,9 +1,9 @@
 #pragma once
-// the pathtraced tier on the GPU (path_shading.h per pixel, path_frame.h on the host): the
-// device copy of the sky's sampling tables and the path kernels. a frame of n pixels splits each
-// pixel's samples into PathRunsPerPixel(n, spp, 2^18) runs of consecutive samples, so that about
-// 2^18 threads trace at once (a 128x96 frame at 1024 spp: 22 runs of 47 samples; frames with
-// media run the kernel's TracePath<true> instance, frames with particle streaks its
+// the pathtraced tier on the GPU (render/transport/path_trace.h per pixel, path_frame.h on the
+// host): the device copy of the sky's sampling tables and the path kernels. a frame of n pixels
+// splits each pixel's samples into PathRunsPerPixel(n, spp, 2^18) runs of consecutive samples, so
+// that about 2^18 threads trace at once (a 128x96 frame at 1024 spp: 22 runs of 47 samples; frames
+// with media run the kernel's TracePath<true> instance, frames with particle streaks its
 // TracePath<..., true> instances, frames with neither the one of before); one thread a
 // run sums its samples in sample order in double (PathSampleRange), then one thread a pixel adds
 // its runs in run order and writes the pixel (PathFinishPixel). no atomics: frames are
@@ -16,7 +16,7 @@
 
 #include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/cuda/path_buffers.h"
-#include "penumbra/render/cuda/path_shading.h"
+#include "penumbra/render/transport/path_trace.h"
 
 namespace penumbra::cuda {
 

@@ -1,8 +1,8 @@
 #pragma once
-// the host side of the pathtraced tier on the GPU (path_shading.h per pixel, path_kernels.cu on
-// the device): which frames it takes, the frame's plain data (PathFrameView over a prepared
-// RealtimeFrameData: the same posed scene, materials, textures, lights and sky), and the finish
-// every pathtraced frame gets on the host, as the CPU backend's EmbreeRenderer gives it: the
+// the host side of the pathtraced tier on the GPU (render/transport/path_trace.h per pixel,
+// path_kernels.cu on the device): which frames it takes, the frame's plain data (PathFrameView over
+// a prepared RealtimeFrameData: the same posed scene, materials, textures, lights and sky), and the
+// finish every pathtraced frame gets on the host, as the CPU backend's EmbreeRenderer gives it: the
 // a-trous denoiser (render/denoiser.h, guided by the albedo, normal and depth) when the settings
 // ask for it, then the film's auto exposure and development (render/film.h).
 // RenderPathtracedOnHost runs the GPU path's per-pixel functions on the CPU over the host BVH
@@ -14,11 +14,11 @@
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/path_buffers.h"
-#include "penumbra/render/cuda/path_shading.h"
 #include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/denoiser.h"
 #include "penumbra/render/emitter_sampler.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/transport/path_trace.h"
 
 namespace penumbra::cuda {
 

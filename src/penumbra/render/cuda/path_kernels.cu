@@ -1,5 +1,5 @@
 // the pathtraced tier's kernels (cuda_path.h): each thread runs the PB_HOST_DEVICE functions of
-// path_shading.h (a run of one pixel's samples, then a pixel's finish), which
+// render/transport/path_trace.h (a run of one pixel's samples, then a pixel's finish), which
 // RenderPathtracedOnHost runs on the CPU.
 
 #include <cuda_runtime.h>
@@ -11,7 +11,7 @@
 #include "penumbra/render/cuda/cuda_device_buffer.h"
 #include "penumbra/render/cuda/cuda_path.h"
 #include "penumbra/render/cuda/media_grid_upload.h"
-#include "penumbra/render/cuda/path_shading.h"
+#include "penumbra/render/transport/path_trace.h"
 #include "penumbra/render/cuda/streak_upload.h"
 
 namespace penumbra::cuda {

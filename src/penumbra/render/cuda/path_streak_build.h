@@ -10,10 +10,10 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "penumbra/render/bvh/bvh_types.h"
 #include "penumbra/render/cuda/bvh_builder.h"
-#include "penumbra/render/cuda/bvh_types.h"
-#include "penumbra/render/cuda/path_streaks.h"
 #include "penumbra/render/particle_streaks.h"
+#include "penumbra/render/transport/path_streaks.h"
 
 namespace penumbra::cuda {
 
@@ -32,7 +32,7 @@ class PathStreakBuild {
   void BuildList(const ParticleStreaks& streaks, const Eigen::Vector3f& sky_ambient);
   /// the particle sets of `streaks` (Built for the frame; none without a frame) and
   /// `sky_ambient` without any streak (empty() stays true): for streaks that stay where they
-  /// were made (the device culling's, branch gpu30), which ViewOver points at. the sets do not
+  /// were made (the device culling's), which ViewOver points at. the sets do not
   /// depend on the streaks (ParticleStreaks::SetPod reads the effects' particle sets only).
   void BuildSets(const ParticleStreaks& streaks, const Eigen::Vector3f& sky_ambient);
   /// this object's particle sets and sky_ambient over `num` StreakPods at `streaks` (index

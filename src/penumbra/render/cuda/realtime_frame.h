@@ -1,5 +1,5 @@
 #pragma once
-// the host side of the CUDA backend's realtime tier (realtime_shading.h): the scene's
+// the host side of the CUDA backend's realtime tier (render/transport/realtime.h): the scene's
 // materials, 2d textures (every mip level) and geoms as plain data, made once; per frame the
 // posed lights (LightSampler), the geoms' poses, the pinhole camera and the frame's random-number
 // key; the frame's effects (light scales and extra lights through
@@ -14,11 +14,11 @@
 // device; the kernels' view pass draws them and
 // the streaks seen through them); the sky model and sky volume (SkyData, for
 // DeviceRealtime::UploadSky) and, for the host path, the per-pixel sky terms from the primary rays'
-// geometry (QuadSkyTerms of realtime_shading.h: the shared lookups of render/sky_eval_math.h, which
-// the device's sky kernel runs too) and those of the mirror layer's reflected rays
-// (MirrorSkyTerms); and the film's exposure and encoding table. RenderRealtimeOnHost runs the GPU
-// path's per-pixel functions on the CPU over the host BVH (tests; the parity check without a GPU).
-// no CUDA runtime here: this file builds on machines without nvcc.
+// geometry (QuadSkyTerms of render/transport/realtime_shading.h: the shared lookups of
+// render/sky_eval_math.h, which the device's sky kernel runs too) and those of the mirror layer's
+// reflected rays (MirrorSkyTerms); and the film's exposure and encoding table. RenderRealtimeOnHost
+// runs the GPU path's per-pixel functions on the CPU over the host BVH (tests; the parity check
+// without a GPU). no CUDA runtime here: this file builds on machines without nvcc.
 
 #include <cstdint>
 #include <functional>
@@ -32,7 +32,6 @@
 #include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/path_streak_build.h"
-#include "penumbra/render/cuda/realtime_shading.h"
 #include "penumbra/render/effects_sky.h"
 #include "penumbra/render/film.h"
 #include "penumbra/render/light_sampler.h"
@@ -45,6 +44,7 @@
 #include "penumbra/render/shelter_map.h"
 #include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"
+#include "penumbra/render/transport/realtime.h"
 
 namespace penumbra::cuda {
 
@@ -70,7 +70,7 @@ class RealtimeFrameData {
   /// shadow rays (see there). `streaks` false: PrepareStreaks is left out and the frame has no
   /// streaks (those of an earlier frame are dropped) until the caller calls it, after PrepareMedia
   /// (the same streaks: PrepareStreaks reads nothing PrepareMedia writes); CudaRenderer does so
-  /// while the GPU shades (CudaRenderer::set_late_streaks, branch gpu23).
+  /// while the GPU shades (CudaRenderer::set_late_streaks).
   /// @throws ConfigError for effects out of range (a negative light or sky scale, a wetness
   /// outside [0, 1]), as the CPU backend; with `streaks`, as PrepareStreaks.
   void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool,
@@ -107,7 +107,7 @@ class RealtimeFrameData {
   /// whether PrepareMedia leaves the media volumes (the grids' light volumes and froxels, the
   /// world light volume's cells, the fog froxels) to the frame (View's media_build: the
   /// device's kernels, or BuildMediaVolumesOnHost; default true) or builds them on the host with
-  /// the rest of RealtimeMedia (false: as before branch gpu15).
+  /// the rest of RealtimeMedia (false).
   void set_device_media(bool on) { device_media_ = on; }
   bool device_media() const { return device_media_; }
   /// the camera-independent part of Prepare: the lights, the geoms (their transforms made
@@ -142,10 +142,10 @@ class RealtimeFrameData {
   /// the streak pixels of the last PrepareStreaks (the host splat; empty with device_streaks).
   const std::vector<StreakPixel>& streaks() const { return streaks_; }
   /// whether the realtime tier's streaks are splatted and shaded per pixel by the frame itself
-  /// (default true, branch gpu18: PrepareStreaks culls the drops on the host as before, then
+  /// (default true: PrepareStreaks culls the drops on the host, then
   /// hands the streaks in index order to View's `splat`, StreakSplatView: the device's splat
   /// kernels, or RenderRealtimeOnHost) or found and shaded on the host (false: the CPU's
-  /// ParticleStreaks splat, PrecomputeRain and Shade, View's `streaks`, as before; benchmarks
+  /// ParticleStreaks splat, PrecomputeRain and Shade, View's `streaks`; benchmarks
   /// and tests compare the two).
   void set_device_streaks(bool on) { device_streaks_ = on; }
   bool device_streaks() const { return device_streaks_; }
@@ -157,7 +157,7 @@ class RealtimeFrameData {
   const PathStreakBuild& splat_streaks() const;
   /// whether a device drop culler is set (set_device_drop_culler).
   bool has_drop_culler() const { return static_cast<bool>(device_drop_culler_); }
-  /// streaks a device drop culler made and keeps on the device (branch gpu30): the frame's
+  /// streaks a device drop culler made and keeps on the device: the frame's
   /// splat reads them in place (StreakSplatView: streaks.streaks, bound as streaks.num, count)
   /// without the host waiting for the culling or copying them.
   struct DeviceStreakList {
@@ -173,8 +173,8 @@ class RealtimeFrameData {
     /// the culler's errors (ConfigError for a non-finite drop).
     std::function<void(std::vector<StreakPod>* out)> download;
   };
-  /// the drops' culling on the device (branch gpu27, without the host's wait since gpu30;
-  /// CudaRenderer::set_device_culling sets it): with device_streaks under the realtime tier's
+  /// the drops' culling on the device, without the host's wait
+  /// (CudaRenderer::set_device_culling sets it): with device_streaks under the realtime tier's
   /// settings, PrepareStreaks has ParticleStreaks prepare the decision's inputs only
   /// (set_host_culling(false): the sets' lengths checked, no drop decided) and calls it with the
   /// frame's effects and those inputs; it queues its work (the drawn streaks in index order,

@@ -7,7 +7,7 @@
 // transforms rewritten from every snapshot (no BLAS rebuild), and a small BVH over their world
 // boxes, rebuilt on the host when the boxes change (occlusion rays walk it). no Eigen and no
 // standard containers here: device code reads these through raw pointers
-// (render/cuda/bvh_traversal.h).
+// (render/bvh/bvh_traversal.h).
 
 #include <cstddef>
 #include <cstdint>
@@ -147,14 +147,6 @@ struct SceneView {
   /// and TraceOccluded test every instance in index order).
   const int32_t* tlas_instances = nullptr;
   Blas tlas;
-  /// 1: TraceOccluded walks the top level (where there is one); 0: it tests every instance in
-  /// index order (the benchmark's ablation, RealtimeKernelOptions::occlusion_tlas). the same
-  /// verdicts either way.
-  int32_t occlusion_tlas = 1;
-  /// 1: TraceClosest walks the top level (where there is one), nearer child first; 0: it tests
-  /// every instance in index order (the benchmark's ablation, RealtimeKernelOptions::
-  /// closest_tlas). the same hits either way, bit for bit.
-  int32_t closest_tlas = 1;
   const Record* records = nullptr;           ///< by PrimRef::record
   const TriangleShading* shading = nullptr;  ///< by PrimRef::shading (closest hits only)
 };

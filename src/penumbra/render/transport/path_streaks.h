@@ -1,7 +1,7 @@
 #pragma once
 // the particle streaks (rain, snow, sparks) of a pathtraced frame as the path kernels trace
 // them, written once as PB_HOST_DEVICE functions over plain data: the GPU (path_kernels.cu) and
-// the host path (TracePathtracedOnHost) run them. every streak is the capsule of the CPU's
+// the host path (RenderPathtracedOnHost) run them. every streak is the capsule of the CPU's
 // ParticleStreaks (render/particle_streaks.h: the segment a particle sweeps in the exposure, its
 // widened radius), which the CPU backend traces as an Embree round linear curve
 // (render/embree/particle_scene.h); here a BVH over the capsules' boxes (built on the host per
@@ -14,8 +14,8 @@
 
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/bsdf_math.h"
-#include "penumbra/render/cuda/bvh_traversal.h"
-#include "penumbra/render/cuda/bvh_types.h"
+#include "penumbra/render/bvh/bvh_traversal.h"
+#include "penumbra/render/bvh/bvh_types.h"
 #include "penumbra/render/particle_math.h"
 #include "penumbra/render/shading_math.h"
 

@@ -18,7 +18,7 @@
 
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/analytic_shape_math.h"
-#include "penumbra/render/cuda/bvh_types.h"
+#include "penumbra/render/bvh/bvh_types.h"
 
 namespace penumbra::cuda {
 
@@ -40,8 +40,8 @@ struct alignas(16) BvhPending {
 /// push: the builders keep trees shallower); the traversal pushes and pops through it, so a
 /// policy that keeps the entries elsewhere visits the same nodes in the same order and gives the
 /// same hits, bit for bit (the tests count the stack's depth through one). a top of 8 entries in
-/// shared memory was slower on an H100 (docs/gpu-notes.md, "The traversal's local memory (branch
-/// gpu29)").
+/// shared memory was slower on an H100 (docs/journal/2026-11-26-gpu-speed.md,
+/// "The traversal's local memory").
 template <int kEntries>
 struct ArrayBvhStack {
   static constexpr int kCapacity = kEntries;
@@ -376,10 +376,10 @@ PB_HOST_DEVICE inline float ClosestTieBound(float t, float tmax) {
 /// flat loop's hit bit for bit (t, u, v, part, prim, instance), the loop that tests every
 /// instance in index order (its world box against the best t so far, then its BLAS with that
 /// t as the bound, a hit kept if strictly nearer), so the lower instance wins a tie and within
-/// a BLAS the first primitive in its traversal's order. with s.closest_tlas and a top level
-/// (s.tlas) it walks the top level nearer child first (TraverseWideBvh; a popped entry is
+/// a BLAS the first primitive in its traversal's order. with a top level (s.tlas,
+/// s.tlas_instances) it walks the top level nearer child first (TraverseWideBvh; a popped entry is
 /// skipped when beyond the bound below) and tests each instance of a leaf as the loop does; its
-/// switch off (or no top level) it is that loop (TopLevelRoot). Stack: TraverseWideBvh's, for
+/// without a top level it is that loop (TopLevelRoot). Stack: TraverseWideBvh's, for
 /// each BLAS; kTies: ClosestTies (the tests' variants).
 ///
 /// why the loop's hit. the instances come in another order, so an instance i is tested
@@ -428,7 +428,7 @@ PB_HOST_DEVICE inline void TraceClosest(const SceneView& s, const TraceRay& r, T
   hit->instance = -1;
   hit->prim = -1;
   const F3 inv{1.0f / r.d.x, 1.0f / r.d.y, 1.0f / r.d.z};
-  const bool tree = s.closest_tlas != 0 && s.tlas_instances != nullptr;
+  const bool tree = s.tlas_instances != nullptr;
   const Blas top = TopLevelRoot(s, tree);
   // the bound of an instance below the best hit's and of the top level's boxes
   float below = r.tmax;
@@ -455,7 +455,7 @@ PB_HOST_DEVICE inline void TraceClosest(const SceneView& s, const TraceRay& r, T
 /// true if anything blocks ray r in (tmin, tmax). Stack: TraverseWideBvh's, for each BLAS.
 /// kAnyOrder (the default): the top level and each BLAS in their children's stored order, no
 /// entry test on a pop (TraverseWideBvh; the same verdict as false, the nearer child first,
-/// which the tests compare). the top level (s.tlas, with s.occlusion_tlas and tlas_instances)
+/// which the tests compare). the top level (s.tlas, with tlas_instances)
 /// is walked as a BLAS whose leaves hold instances: each instance of a leaf the ray reaches is
 /// tested as the flat list tests it (its own box, then its BLAS). the same verdict as the flat
 /// list: an any-hit traversal's verdict does not depend on its order (TraverseWideBvh), and a
@@ -468,7 +468,7 @@ PB_HOST_DEVICE inline bool TraceOccluded(const SceneView& s, const TraceRay& r) 
   TraceHit hit;
   hit.t = r.tmax;
   const F3 inv{1.0f / r.d.x, 1.0f / r.d.y, 1.0f / r.d.z};
-  const bool tree = s.occlusion_tlas != 0 && s.tlas_instances != nullptr;
+  const bool tree = s.tlas_instances != nullptr;
   const Blas top = TopLevelRoot(s, tree);
   auto leaf = [&](int k) {
     const int i = tree ? LoadTlasInstance(s.tlas_instances + k) : k;

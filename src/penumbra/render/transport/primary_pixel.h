@@ -1,21 +1,40 @@
 #pragma once
-// one pixel of a pinhole camera's ground-truth images, written once as PB_HOST_DEVICE
-// functions: the batch kernel (cuda_batch_kernels.cu) runs them on the GPU, the host tests
-// (tests/render/cuda/batch_layout_test.cc) on the CPU over the same BvhScene arrays. the ray
-// through pixel (u, v) (pixel centres are integers) is o + t (((u - cx) inv_fx) ex +
-// ((v - cy) inv_fy) ey + ez) of PinholeCamera (cuda_kernels.h), as Camera::GenerateRay
-// (render/camera.h) for a camera without distortion or motion.
+// the camera's pixel rays and what a hit is on the scene's plain data: the pinhole camera
+// (PinholeCamera: the ray through pixel (u, v), pixel centres integers, is o + t (((u - cx)
+// inv_fx) ex + ((v - cy) inv_fy) ey + ez), as Camera::GenerateRay for a camera without
+// distortion or motion), a hit's geometric and shading normals and texcoords (HitNormal,
+// HitShadingNormal, HitTexcoords) and one pixel's ground-truth images (TracePixelTruth), written
+// once as PB_HOST_DEVICE functions: the batch kernel (render/cuda/cuda_batch_kernels.cu) runs them
+// on the GPU, the host tests (tests/render/cuda/batch_layout_test.cc) on the CPU over the same
+// BvhScene arrays.
 
 #include <cmath>
 #include <cstdint>
 
 #include "penumbra/core/host_device.h"
-#include "penumbra/render/cuda/bvh_traversal.h"
-#include "penumbra/render/cuda/bvh_types.h"
+#include "penumbra/render/bvh/bvh_traversal.h"
+#include "penumbra/render/bvh/bvh_types.h"
 #include "penumbra/render/mesh_shading_math.h"
 #include "penumbra/render/shading_math.h"
 
 namespace penumbra::cuda {
+
+/// a pinhole camera as the primary-ray kernel takes it: world ray through pixel (u, v) (pixel
+/// centres are integers) is o + t (((u - cx) inv_fx) ex + ((v - cy) inv_fy) ey + ez), as
+/// Camera::GenerateRay (render/camera.h) for a camera without distortion or motion.
+struct PinholeCamera {
+  F3 o, ex, ey, ez;
+  float cx = 0, cy = 0, inv_fx = 1, inv_fy = 1;
+  float near = 0;
+  int width = 0, height = 0;
+  /// a camera with lens distortion: (height x width x 2) undistorted normalised coordinates
+  /// (x, y) of the pixel centres, used instead of ((u - cx) inv_fx, (v - cy) inv_fy); null = a
+  /// pinhole. a moving camera (rolling shutter): (height x 12) per row o, ex, ey, ez, used
+  /// instead of the fields above; null = one pose. both in the memory the reader runs in (host
+  /// or device); render/cuda/camera_rays.h fills them.
+  const float* xy = nullptr;
+  const float* rows = nullptr;
+};
 
 /// the ground truth of one pixel: depth along the optical axis (m; 0 = miss), range along the
 /// ray (m; 0 = miss), the MuJoCo geom id (-1 = miss or no geom), the body (instance) id (-1 =
