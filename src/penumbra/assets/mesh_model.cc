@@ -15,6 +15,7 @@
 #include "penumbra/assets/height_field_model.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/core/srgb.h"
 #include "penumbra/decompose/decomposition_cache.h"
 #include "penumbra/decompose/mesh_io.h"
 #include "penumbra/render/backends/renderer_factory.h"
@@ -52,12 +53,6 @@ std::string XmlEscape(const std::string& s) {
     }
   }
   return out;
-}
-
-// linear -> sRGB-encoded value in [0, 1] (IEC 61966-2-1), for MuJoCo's rgba.
-double LinearToSrgb(double v) {
-  v = std::clamp(v, 0.0, 1.0);
-  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
 }
 
 }  // namespace
@@ -125,8 +120,8 @@ std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::str
   for (const ImportedMaterial& m : asset.materials) {
     const Eigen::Vector3f& c = m.factors.base_color;
     x += fmt::format("    <material name=\"{}\" rgba=\"{:.6g} {:.6g} {:.6g} 1\"/>\n",
-                     XmlEscape(m.name), LinearToSrgb(c.x()), LinearToSrgb(c.y()),
-                     LinearToSrgb(c.z()));
+                     XmlEscape(m.name), LinearToSrgb<double>(c.x()), LinearToSrgb<double>(c.y()),
+                     LinearToSrgb<double>(c.z()));
   }
   x += collision.convex_parts.assets;
   if (collision.hfield)

@@ -98,12 +98,6 @@ Light LightFromMjcf(const mjModel* m, const mjData* d, int i) {
 
 }  // namespace
 
-float SrgbToLinear(float c) {
-  c = std::clamp(c, 0.0f, 1.0f);
-  if (c <= 0.04045f) return c / 12.92f;
-  return std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
-
 Material MaterialFromMjcf(const std::string& name, const float rgba[4], float emission,
                           float specular, float shininess, float reflectance, int texture,
                           const float texrepeat[2], bool texuniform) {

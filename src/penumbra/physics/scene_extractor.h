@@ -39,6 +39,7 @@
 
 #include <string>
 
+#include "penumbra/core/srgb.h"  // SrgbToLinear, the decoding of MJCF rgba
 #include "penumbra/scene/scene_description.h"
 
 struct mjModel_;
@@ -57,9 +58,6 @@ inline constexpr double kMjcfEmissionLuminance = kMjcfDirectionalLux / 3.1415926
 inline constexpr double kMjcfLampMinDistance = 1.0;
 /// lower roughness bound of the shininess mapping.
 inline constexpr float kMjcfMinRoughness = 0.05f;
-
-/// IEC 61966-2-1 sRGB decoding of one channel in [0, 1] to linear.
-float SrgbToLinear(float srgb);
 
 /// PBR material from MJCF appearance values (see the file comment). `rgba` is the
 /// effective colour (sRGB, alpha); `texture` is a SceneDescription texture index or -1.

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "penumbra/core/srgb.h"
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -80,8 +82,7 @@ double SumLog(const float* rgb, int n) {
 Film::Film(const RenderSettings& settings) : settings_(settings), oetf_lut_(kLutSize) {
   for (int i = 0; i < kLutSize; ++i) {
     const double v = static_cast<double>(i) / (kLutSize - 1);
-    const double e = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
-    oetf_lut_[i] = static_cast<uint8_t>(std::lround(std::clamp(e, 0.0, 1.0) * 255.0));
+    oetf_lut_[i] = static_cast<uint8_t>(std::lround(std::clamp(LinearToSrgb(v), 0.0, 1.0) * 255.0));
   }
 }
 

@@ -39,8 +39,8 @@ namespace penumbra {
 
 // kMinLuminance: render/film_math.h.
 
-// ExposureFromEv100, AcesFilmic, HuePreservingFilmic and SrgbOetf: render/film_math.h (shared
-// with the CUDA backend).
+// ExposureFromEv100, AcesFilmic and HuePreservingFilmic: render/film_math.h (shared with the
+// CUDA backend); the sRGB encoding of the table: LinearToSrgb, core/srgb.h.
 
 /// turns radiance images into display images. immutable, thread-compatible.
 class Film {

@@ -39,12 +39,6 @@ PB_HOST_DEVICE inline void HuePreservingFilmic(const float x[3], float y[3]) {
   for (int c = 0; c < 3; ++c) y[c] = pbm::Clamp(pbm::Max(x[c], 0.0f) * ratio, 0.0f, 1.0f);
 }
 
-/// sRGB OETF (IEC 61966-2-1) of a linear value in [0, 1].
-PB_HOST_DEVICE inline float SrgbOetf(float linear) {
-  const float v = pbm::Clamp(linear, 0.0f, 1.0f);
-  return v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
-}
-
 /// index into the encoding table of a tone-mapped value x in [0, 1]: round(x (size - 1));
 /// NaN-safe (!(x > 0) maps to 0).
 PB_HOST_DEVICE inline int32_t FilmLutIndex(float x) {

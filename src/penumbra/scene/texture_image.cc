@@ -8,15 +8,11 @@
 #include <thread>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/srgb.h"
 #include "penumbra/core/thread_pool.h"
 
 namespace penumbra {
 namespace {
-
-// sRGB EOTF, IEC 61966-2-1: code value in [0, 1] to linear.
-double SrgbToLinear(double c) {
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-}
 
 struct SrgbTables {
   std::array<float, 256> decode;

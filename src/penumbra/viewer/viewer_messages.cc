@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/srgb.h"
 
 namespace penumbra {
 
@@ -33,12 +34,6 @@ const char* ShapeName(GeomShape s) {
       return "hfield";
   }
   return "box";
-}
-
-// linear -> display sRGB (IEC 61966-2-1)
-double ToSrgb(double c) {
-  c = std::clamp(c, 0.0, 1.0);
-  return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
 }
 
 }  // namespace
@@ -71,14 +66,15 @@ json SceneJson(const SceneDescription& scene) {
       alpha = scene.materials[g.material].alpha;
     }
     if (alpha < 0.5f) continue;
-    json jg = {{"body", g.body},
-               {"shape", ShapeName(g.shape)},
-               {"size", {g.size.x(), g.size.y(), g.size.z()}},
-               {"color",
-                {Round(ToSrgb(rgb.x()), 1e3), Round(ToSrgb(rgb.y()), 1e3),
-                 Round(ToSrgb(rgb.z()), 1e3), Round(alpha, 1e3)}},
-               {"mesh", -1},
-               {"hfield", -1}};
+    json jg = {
+        {"body", g.body},
+        {"shape", ShapeName(g.shape)},
+        {"size", {g.size.x(), g.size.y(), g.size.z()}},
+        {"color",
+         {Round(LinearToSrgb<double>(rgb.x()), 1e3), Round(LinearToSrgb<double>(rgb.y()), 1e3),
+          Round(LinearToSrgb<double>(rgb.z()), 1e3), Round(alpha, 1e3)}},
+        {"mesh", -1},
+        {"hfield", -1}};
     const json pose = PoseJson(g.X_BG);
     jg["pos"] = {pose[0], pose[1], pose[2]};
     jg["quat"] = {pose[3], pose[4], pose[5], pose[6]};
