@@ -74,6 +74,18 @@ void Denoiser::Denoise(const ImageF& radiance, const DenoiserGuides& guides, Thr
   const float* normal = guides.normal->data.data();
   const float* depth = guides.depth->data.data();
   auto has_surface = [&](size_t i) { return depth[i] > 0 && std::isfinite(depth[i]); };
+  // f(du, dv, j) for each pixel j at offset (du, dv), |du|, |dv| <= radius, from pixel (u, v)
+  // that lies in the image and on a surface; rows outer, each left to right.
+  auto for_surface_neighbours = [&](int u, int v, int radius, auto&& f) {
+    for (int dv = -radius; dv <= radius; ++dv) {
+      for (int du = -radius; du <= radius; ++du) {
+        const int uu = u + du, vv = v + dv;
+        if (uu < 0 || uu >= w || vv < 0 || vv >= h) continue;
+        const size_t j = static_cast<size_t>(vv) * w + uu;
+        if (has_surface(j)) f(du, dv, j);
+      }
+    }
+  };
 
   // demodulated irradiance (3 channels) and the variance of its luminance.
   std::vector<float> cur(n * 3), next(n * 3), var(n), var_next(n);
@@ -150,20 +162,14 @@ void Denoiser::Denoise(const ImageF& radiance, const DenoiserGuides& guides, Thr
         var[i] = 0;
         if (!has_surface(i)) continue;
         double sw = 0, s1 = 0, s2 = 0;
-        for (int dv = -2; dv <= 2; ++dv) {
-          for (int du = -2; du <= 2; ++du) {
-            const int uu = u + du, vv = static_cast<int>(v) + dv;
-            if (uu < 0 || uu >= w || vv < 0 || vv >= h) continue;
-            const size_t j = static_cast<size_t>(vv) * w + uu;
-            if (!has_surface(j)) continue;
-            float dt = 0;
-            const float wg = geometry_weight(i, j, du, dv, &dt) * std::exp(-dt);
-            const double l = DenoiseLuminance(&cur[j * 3]);
-            sw += wg;
-            s1 += wg * l;
-            s2 += wg * l * l;
-          }
-        }
+        for_surface_neighbours(u, static_cast<int>(v), 2, [&](int du, int dv, size_t j) {
+          float dt = 0;
+          const float wg = geometry_weight(i, j, du, dv, &dt) * std::exp(-dt);
+          const double l = DenoiseLuminance(&cur[j * 3]);
+          sw += wg;
+          s1 += wg * l;
+          s2 += wg * l * l;
+        });
         const double mean = s1 / sw;
         var[i] = static_cast<float>(std::max(0.0, s2 / sw - mean * mean));
       }
@@ -182,17 +188,11 @@ void Denoiser::Denoise(const ImageF& radiance, const DenoiserGuides& guides, Thr
         }
         // 3x3 gaussian of the variance for a stabler luminance test (SVGF, eq. 5).
         double gv = 0, gw = 0;
-        for (int dv = -1; dv <= 1; ++dv) {
-          for (int du = -1; du <= 1; ++du) {
-            const int uu = u + du, vv = static_cast<int>(v) + dv;
-            if (uu < 0 || uu >= w || vv < 0 || vv >= h) continue;
-            const size_t j = static_cast<size_t>(vv) * w + uu;
-            if (!has_surface(j)) continue;
-            const double k = (du == 0 ? 0.5 : 0.25) * (dv == 0 ? 0.5 : 0.25);
-            gv += k * var[j];
-            gw += k;
-          }
-        }
+        for_surface_neighbours(u, static_cast<int>(v), 1, [&](int du, int dv, size_t j) {
+          const double k = (du == 0 ? 0.5 : 0.25) * (dv == 0 ? 0.5 : 0.25);
+          gv += k * var[j];
+          gw += k;
+        });
         const float li = DenoiseLuminance(&cur[i * 3]);
         const float lum_scale =
             settings_.sigma_luminance * static_cast<float>(std::sqrt(std::max(0.0, gv / gw))) +

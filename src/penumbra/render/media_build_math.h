@@ -195,7 +195,7 @@ PB_HOST_DEVICE inline float FogColumnFar(const MediumPod* media, int n, const fl
     if (!MediumInterval(m, o, d, 0.0f, INFINITY, &a, &b)) continue;
     const double tt = MediaInvertDensityIntegral(m.falloff, m.base, o[2], d[2], a, b,
                                                  4.6 / MediaMean3(m.sigma_t));
-    const double end = tt == tt && !MediaIsInfD(tt) ? tt : static_cast<double>(b);
+    const double end = tt == tt && !MediaIsInf(tt) ? tt : static_cast<double>(b);
     t_far = pbm::Max(t_far, static_cast<float>(pbm::Min(end, 2000.0)));
   }
   return pbm::Min(t_far, 2000.0f);

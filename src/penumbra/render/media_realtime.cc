@@ -32,6 +32,17 @@ void BuildAxisTables(int n, int block, int columns, std::vector<RealtimeMedia::A
   }
 }
 
+// the column layout of froxels `fr` (Froxels or FogFroxels) over a w x h image in square
+// blocks of `block` pixels: nx, ny and the axis tables; returns the number of columns.
+template <typename F>
+int LayOutColumns(int w, int h, int block, F* fr) {
+  fr->nx = (w + block - 1) / block;
+  fr->ny = (h + block - 1) / block;
+  BuildAxisTables(w, block, fr->nx, &fr->ax, &fr->ax_half);
+  BuildAxisTables(h, block, fr->ny, &fr->ay, &fr->ay_half);
+  return fr->nx * fr->ny;
+}
+
 // MediaColumnsAt(u, v) of pixel (u, v) (from the tables inside the image).
 template <typename F>
 ColumnBilerp PixelColumns(const F& fr, int u, int v, int block) {
@@ -379,12 +390,8 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
   if (media.grids().empty()) return;
   const int W = camera.width(), H = camera.height();
   Froxels& fr = froxels_;
-  fr.nx = (W + kFroxelBlock - 1) / kFroxelBlock;
-  fr.ny = (H + kFroxelBlock - 1) / kFroxelBlock;
-  const int columns = fr.nx * fr.ny;
+  const int columns = LayOutColumns(W, H, kFroxelBlock, &fr);
   constexpr int Z = kFroxelSlices;
-  BuildAxisTables(W, kFroxelBlock, fr.nx, &fr.ax, &fr.ax_half);
-  BuildAxisTables(H, kFroxelBlock, fr.ny, &fr.ay, &fr.ay_half);
   if (device) return;  // the layout only: the columns are the device's
   fr.t0.assign(columns, 0.0f);
   fr.t1.assign(columns, 0.0f);
@@ -401,9 +408,8 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
   b.num_media = static_cast<int>(pods_.size());
   static_assert(sizeof(FroxelRecord) == 8 * sizeof(float), "records of 8 floats");
   auto column = [&](int64_t c) {
-    const int cx = static_cast<int>(c % fr.nx), cy = static_cast<int>(c / fr.nx);
-    const int uc = std::min(cx * kFroxelBlock + kFroxelBlock / 2, W - 1);
-    const int vc = std::min(cy * kFroxelBlock + kFroxelBlock / 2, H - 1);
+    int uc, vc;
+    MediaColumnCentre(static_cast<int>(c), fr.nx, kFroxelBlock, W, H, &uc, &vc);
     const Ray r = camera.GenerateRay(static_cast<float>(uc), static_cast<float>(vc));
     const Eigen::Vector3f o = r.o, d = r.d.normalized();
     float a, e;
@@ -436,12 +442,8 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
   if (media.analytic().empty() || lights.size() == 0) return;
   const int W = camera.width(), H = camera.height();
   FogFroxels& fr = fog_froxels_;
-  fr.nx = (W + kFogFroxelBlock - 1) / kFogFroxelBlock;
-  fr.ny = (H + kFogFroxelBlock - 1) / kFogFroxelBlock;
-  const int columns = fr.nx * fr.ny;
+  const int columns = LayOutColumns(W, H, kFogFroxelBlock, &fr);
   constexpr int Z = kFogFroxelSlices;
-  BuildAxisTables(W, kFogFroxelBlock, fr.nx, &fr.ax, &fr.ax_half);
-  BuildAxisTables(H, kFogFroxelBlock, fr.ny, &fr.ay, &fr.ay_half);
   fr.inv_log_far.assign(columns, 1.0f / std::log(2.0f));
   if (device) return;  // the layout only: the columns are the device's
   fr.S.assign(static_cast<size_t>(columns) * (Z + 1), Eigen::Array4f::Zero());
@@ -466,9 +468,8 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
   }
   const Eigen::Array4f zero = Eigen::Array4f::Zero(), unit(1, 1, 1, 0);
   auto column = [&](int64_t c) {
-    const int cx = static_cast<int>(c % fr.nx), cy = static_cast<int>(c / fr.nx);
-    const int uc = std::min(cx * kFogFroxelBlock + kFogFroxelBlock / 2, W - 1);
-    const int vc = std::min(cy * kFogFroxelBlock + kFogFroxelBlock / 2, H - 1);
+    int uc, vc;
+    MediaColumnCentre(static_cast<int>(c), fr.nx, kFogFroxelBlock, W, H, &uc, &vc);
     const Ray r = camera.GenerateRay(static_cast<float>(uc), static_cast<float>(vc));
     const Eigen::Vector3f o = r.o, d = r.d.normalized();
     const MediaColumns grid_cols =
@@ -670,15 +671,15 @@ bool RealtimeMedia::CellLightsLookupSse(const float* cl, const Eigen::Vector3f& 
   }
   // the eight corners (+1 along x, y, z for bits 0, 1, 2 of the corner index) and their
   // trilinear weights, summed in corner order; lights adjacent per cell.
+  // cl_pod_: vol_'s layout
   const size_t S = static_cast<size_t>(vol_.stride);
-  const size_t nx = static_cast<size_t>(vol_.r[0]), nxy = nx * static_cast<size_t>(vol_.r[1]);
-  const float* c0 = cl + (base[2] * nxy + base[1] * nx + base[0]) * S;
-  const size_t ox = step[0] * S, oy = step[1] * nx * S, oz = step[2] * nxy * S;
+  const CellCorners k = CellLightsCorners(cl_pod_, cl, base, step);
+  const size_t ox = k.ox, oy = k.oy, oz = k.oz;
   float wc[8];
   TrilinearCornerWeights(w, wc);
   using A4 = Eigen::Map<const Eigen::Array4f>;
   for (size_t j0 = 0; j0 < S; j0 += 4) {
-    const float* c = c0 + j0;
+    const float* c = k.c0 + j0;
     Eigen::Array4f sum = wc[0] * A4(c);
     sum += wc[1] * A4(c + ox);
     sum += wc[2] * A4(c + oy);

@@ -72,8 +72,9 @@ PB_HOST_DEVICE inline Rgb4& operator+=(Rgb4& a, const Rgb4& b) {
   return a;
 }
 
-/// x is +inf or -inf (std::isinf).
-PB_HOST_DEVICE inline bool MediaIsInf(float x) {
+/// x (float or double) is +inf or -inf (std::isinf).
+template <typename T>
+PB_HOST_DEVICE inline bool MediaIsInf(T x) {
 #if defined(__CUDA_ARCH__)
   return isinf(x);
 #else
@@ -189,21 +190,12 @@ PB_HOST_DEVICE inline float MediaPhaseHG(float cos_theta, float g) {
   return kInv4Pi * (1.0f - g * g) / (denom * sqrtf(pbm::Max(denom, 1e-12f)));
 }
 
-/// x is +inf or -inf (double).
-PB_HOST_DEVICE inline bool MediaIsInfD(double x) {
-#if defined(__CUDA_ARCH__)
-  return isinf(x);
-#else
-  return __builtin_isinf(x);
-#endif
-}
-
 /// the integral of piece p over [s, e] (+inf for an infinite piece whose density does not
 /// vanish).
 PB_HOST_DEVICE inline double MediaPieceIntegral(const MediaPiece& p) {
   const double len = p.e - p.s;
   if (p.rate == 0 || fabs(p.rate) * len < 1e-9) return p.h_s * len;
-  if (MediaIsInfD(len)) return p.rate > 0 ? p.h_s / p.rate : static_cast<double>(INFINITY);
+  if (MediaIsInf(len)) return p.rate > 0 ? p.h_s / p.rate : static_cast<double>(INFINITY);
   return p.h_s * -expm1(-p.rate * len) / p.rate;
 }
 
@@ -362,7 +354,7 @@ PB_HOST_DEVICE inline bool SkyMedianDistance(const MediumPod* media, int n, cons
   const float tau_med = -log1pf(expf(-best_tau)) + logf(2.0f);  // -ln((1 + T) / 2)
   const double t = MediaInvertDensityIntegral(m.falloff, m.base, o[2], d[2], best_a, best_b,
                                               tau_med / MediaMean3(m.sigma_t));
-  const bool finite = t == t && !MediaIsInfD(t);  // std::isfinite(t)
+  const bool finite = t == t && !MediaIsInf(t);  // std::isfinite(t)
   const float tm = finite ? static_cast<float>(t) : 0.5f * (best_a + best_b);
   if (!pbm::IsFinite(tm)) return false;
   *t_med = tm;
@@ -455,6 +447,26 @@ PB_HOST_DEVICE inline void TrilinearCornerWeights(const float w[3], float out[8]
   out[7] = w[0] * w[1] * w[2];
 }
 
+/// a cell's eight corners in a [cell][light] array of layout `v` (r, stride): the first
+/// corner's record c0 (cell `base`) and the offsets in floats of the +x, +y and +z corners
+/// (`step` 0 or 1 per axis: 0 where the upper corner is clamped onto the lower one); corner k
+/// (+1 along x, y, z for bits 0, 1, 2 of k) starts at c0 + bit0 ox + bit1 oy + bit2 oz.
+struct CellCorners {
+  const float* c0 = nullptr;
+  size_t ox = 0, oy = 0, oz = 0;
+};
+PB_HOST_DEVICE inline CellCorners CellLightsCorners(const CellLightsPod& v, const float* cl,
+                                                    const int base[3], const int step[3]) {
+  const size_t S = static_cast<size_t>(v.stride);
+  const size_t nx = static_cast<size_t>(v.r[0]), nxy = nx * static_cast<size_t>(v.r[1]);
+  CellCorners k;
+  k.c0 = cl + (base[2] * nxy + base[1] * nx + base[0]) * S;
+  k.ox = step[0] * S;
+  k.oy = step[1] * nx * S;
+  k.oz = step[2] * nxy * S;
+  return k;
+}
+
 /// trilinear lookup at p (world, m) of every light's value in a [cell][light] array `cl` of
 /// the world light volume into out[0 .. stride); false outside the box (out untouched). per
 /// axis c = clamp((p - lo) cells_per_m - 0.5, 0, r - 1), i0 = min(trunc(c), max(r - 2, 0)),
@@ -480,13 +492,12 @@ PB_HOST_DEVICE inline bool CellLightsLookup(const CellLightsPod& v, const float*
     step[k] = i0 + 1.0f <= rmax ? 1 : 0;
   }
   const size_t S = static_cast<size_t>(v.stride);
-  const size_t nx = static_cast<size_t>(v.r[0]), nxy = nx * static_cast<size_t>(v.r[1]);
-  const float* c0 = cl + (base[2] * nxy + base[1] * nx + base[0]) * S;
-  const size_t ox = step[0] * S, oy = step[1] * nx * S, oz = step[2] * nxy * S;
+  const CellCorners k = CellLightsCorners(v, cl, base, step);
+  const size_t ox = k.ox, oy = k.oy, oz = k.oz;
   float wc[8];
   TrilinearCornerWeights(w, wc);
   for (size_t j = 0; j < S; ++j) {
-    const float* c = c0 + j;
+    const float* c = k.c0 + j;
     float sum = wc[0] * c[0];
     sum += wc[1] * c[ox];
     sum += wc[2] * c[oy];
@@ -513,6 +524,15 @@ struct MediaColumns {
   int cols[4];
   float w[4];
 };
+
+/// the centre pixel (*uc, *vc) of froxel column c of a w x h image cut into nx columns of
+/// block x block pixels per row (the pixel a column's ray passes through; clamped into the
+/// image for the last, partial blocks).
+PB_HOST_DEVICE inline void MediaColumnCentre(int c, int nx, int block, int w, int h, int* uc,
+                                             int* vc) {
+  *uc = MediaMinI((c % nx) * block + block / 2, w - 1);
+  *vc = MediaMinI((c / nx) * block + block / 2, h - 1);
+}
 
 /// the axis part of the columns at position x (pixels) of columns centred on blocks of
 /// `block` pixels, `columns` of them along the axis: f = clamp((x - block / 2) / block, 0,
