@@ -483,4 +483,16 @@ PB_HOST_DEVICE inline bool TraceOccluded(const SceneView& s, const TraceRay& r) 
                                                leaf);
 }
 
+/// the ray tracer of the transport's chains (render/transport: a Tracer, their template
+/// parameter, has these two calls) over the BVH of `scene`: the GPU's, and the host's.
+struct BvhTracer {
+  const SceneView& scene;
+  /// the closest hit of r in [tmin, tmax] (TraceClosest); hit->instance -1 where none.
+  PB_HOST_DEVICE void Closest(const TraceRay& r, TraceHit* hit) const {
+    TraceClosest(scene, r, hit);
+  }
+  /// whether anything blocks r in (tmin, tmax) (TraceOccluded).
+  PB_HOST_DEVICE bool Occluded(const TraceRay& r) const { return TraceOccluded(scene, r); }
+};
+
 }  // namespace penumbra::cuda

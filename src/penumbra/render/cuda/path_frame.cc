@@ -114,7 +114,7 @@ void TracePathtracedOnHost(const PathFrameView& frame, ThreadPool* pool, PathBuf
   pf.normal = out->normal.data();
   pf.depth = out->depth.data();
   ParallelForOrSerial(pool, H, [&](int64_t v) {
-    for (int u = 0; u < W; ++u) PathTracePixel(pf, u, static_cast<int>(v));
+    for (int u = 0; u < W; ++u) PathTracePixel(pf, BvhTracer{pf.rt.scene}, u, static_cast<int>(v));
   });
 }
 

@@ -11,8 +11,8 @@
 #include "penumbra/render/cuda/cuda_device_buffer.h"
 #include "penumbra/render/cuda/cuda_path.h"
 #include "penumbra/render/cuda/media_grid_upload.h"
-#include "penumbra/render/transport/path_trace.h"
 #include "penumbra/render/cuda/streak_upload.h"
+#include "penumbra/render/transport/path_trace.h"
 
 namespace penumbra::cuda {
 namespace {
@@ -37,7 +37,8 @@ __global__ void __launch_bounds__(64)
   const int64_t n = static_cast<int64_t>(pf.rt.camera.width) * pf.rt.camera.height;
   const int64_t i = static_cast<int64_t>(v) * pf.rt.camera.width + u;
   partial[k * n + i] =
-      s0 < s1 ? PathSampleRange<kMedia, kParticles>(pf, u, v, s0, s1) : PathPartial{};
+      s0 < s1 ? PathSampleRange<kMedia, kParticles>(pf, BvhTracer{pf.rt.scene}, u, v, s0, s1)
+              : PathPartial{};
 }
 
 // a pixel a thread: its runs' sums added in run order (no atomics), then its outputs.
@@ -53,7 +54,7 @@ __global__ void PathFinishKernel(PathFrameView pf, int runs, const PathPartial* 
     for (int c = 0; c < 3; ++c) p.L[c] += q.L[c], p.albedo[c] += q.albedo[c];
     p.albedo_count += q.albedo_count;
   }
-  PathFinishPixel(pf, u, v, p);
+  PathFinishPixel(pf, BvhTracer{pf.rt.scene}, u, v, p);
 }
 
 void LaunchPath(const PathFrameView& pf, PathPartial* partial, int runs, cudaStream_t stream) {

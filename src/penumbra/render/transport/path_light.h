@@ -175,12 +175,13 @@ PB_HOST_DEVICE inline Float3 PathMediaT(const PathFrameView& pf, const Float3& o
 }
 
 /// next-event estimation at vertex `vx` (PathSurfaceVertex or PathMediumVertex) with path
-/// throughput beta, drawing from rng as the CPU's next_event: one sample of every light, then
-/// the sky, then one emissive geom; with kMedia every unoccluded shadow ray's contribution
-/// times the media's transmittance. adds to *L.
-template <bool kMedia, typename Vertex>
-PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const Vertex& vx,
-                                         const Float3& beta, Rng* rng, Float3* L) {
+/// throughput beta, its shadow rays traced by `tracer` (path_trace.h's Tracer), drawing from rng as
+/// the CPU's next_event: one sample of every light, then the sky, then one emissive geom; with
+/// kMedia every unoccluded shadow ray's contribution times the media's transmittance. adds to *L.
+template <bool kMedia, typename Vertex, class Tracer>
+PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const Tracer& tracer,
+                                         const Vertex& vx, const Float3& beta, Rng* rng,
+                                         Float3* L) {
   const RealtimeFrameView& f = pf.rt;
   const Float3 p = vx.Point();
   for (int j = 0; j < f.num_lights; ++j) {
@@ -212,7 +213,7 @@ PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const Vertex& 
     if (l.cast_shadow != 0) {
       TraceRay sr = vx.Spawn(wi);
       sr.tmax = dist == INFINITY ? INFINITY : dist * (1.0f - kPathShadowShorten);
-      if (TraceOccluded(f.scene, sr)) continue;
+      if (tracer.Occluded(sr)) continue;
       float t;
       if (PathNearestLamp(f, ToFloat3(sr.o), wi, 0.0f, sr.tmax, &t, lamp ? j : -1) >= 0) continue;
       if (kMedia) c = PathMul(c, PathMediaT<kMedia>(pf, ToFloat3(sr.o), wi, sr.tmax, rng));
@@ -233,7 +234,7 @@ PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const Vertex& 
       if (PathMax3(fv) > 0) {
         const TraceRay sr = vx.Spawn(wi);
         float t;
-        if (!TraceOccluded(f.scene, sr) &&
+        if (!tracer.Occluded(sr) &&
             PathNearestLamp(f, ToFloat3(sr.o), wi, 0.0f, INFINITY, &t) < 0) {
           const float w = PowerHeuristic(pdf, f_pdf);
           float sky[3];
@@ -268,7 +269,7 @@ PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const Vertex& 
         const Float3 o = ToFloat3(sr.o), dq = ToFloat3(sr.d);
         const float dist = sqrtf(EigenDot(dq, dq)) * sr.tmax;
         float t;
-        if (!TraceOccluded(f.scene, sr) && PathNearestLamp(f, o, wi, 0.0f, dist, &t) < 0) {
+        if (!tracer.Occluded(sr) && PathNearestLamp(f, o, wi, 0.0f, dist, &t) < 0) {
           const float w = PowerHeuristic(ep.pdf, f_pdf);
           Float3 c = PathMul(beta, PathMul(fv, em.Le[k])) * (w / ep.pdf);
           if (kMedia) c = PathMul(c, PathMediaT<kMedia>(pf, o, wi, dist, rng));

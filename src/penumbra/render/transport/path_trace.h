@@ -22,6 +22,12 @@
 //   in front of the lamp or surface stops there with probability alpha (one draw, before the
 //   free flight, which then ends at the streak), adding the streak's radiance (ShadeStreak);
 //
+// the ray tracer is the chain's one seam to the processor: a Tracer (template parameter, passed
+// by the caller) with Closest(const TraceRay&, TraceHit*) (hit->instance -1: none) and
+// Occluded(const TraceRay&) -> bool, its hits numbered as pf.rt.scene's arrays (instance, prim,
+// u, v, part, t), from which the surface at a hit is read (EvaluateSurface). the GPU and the
+// host runner pass BvhTracer (render/bvh/bvh_traversal.h) over pf.rt.scene.
+//
 // with the shared formulas of render/: the BSDF (bsdf_math.h), the light samples (light_math.h,
 // with LightSampler::Sample's normalisation), the lamp and sun terms and the power heuristic
 // (path_math.h), the emissive geoms' sampling (emitter_math.h), the sky's radiance and
@@ -91,9 +97,9 @@ PB_HOST_DEVICE inline TraceRay JitteredCameraRay(const PinholeCamera& c, int u, 
 /// drop) and, where its camera ray meets a surface, that surface's base colour (*albedo,
 /// *hit_first true). kMedia: the frame has media (pf.media not empty); kParticles: it has
 /// particle streaks (pf.streaks.num > 0).
-template <bool kMedia, bool kParticles = false>
-PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, int u, int v, int s, Float3* albedo,
-                                       bool* hit_first) {
+template <bool kMedia, bool kParticles = false, class Tracer>
+PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, const Tracer& tracer, int u, int v,
+                                       int s, Float3* albedo, bool* hit_first) {
   const RealtimeFrameView& f = pf.rt;
   const PinholeCamera& c = f.camera;
   const uint64_t pixel =
@@ -112,7 +118,7 @@ PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, int u, int v, in
   *hit_first = false;
   for (int vertex = 0;; ++vertex) {
     TraceHit h;
-    TraceClosest(f.scene, ray, &h);
+    tracer.Closest(ray, &h);
     const bool found = h.instance >= 0;
     const float t_surface = found ? h.t : INFINITY;
     const Float3 o = ToFloat3(ray.o), d = ToFloat3(ray.d);
@@ -150,7 +156,7 @@ PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, int u, int v, in
         if (vertex >= pf.max_bounces) break;
         const Float3 p{o.x + t_scatter * d.x, o.y + t_scatter * d.y, o.z + t_scatter * d.z};
         const Float3 wo{-d.x, -d.y, -d.z};
-        PathNextEvent<kMedia>(pf, PathMediumVertex{p, wo, &mp}, beta, &rng, &L);
+        PathNextEvent<kMedia>(pf, tracer, PathMediumVertex{p, wo, &mp}, beta, &rng, &L);
         if (vertex >= kPathRussianRouletteStartVertex) {
           const float q = pbm::Min(1.0f, PathMax3(beta));
           if (!(rng.Uniform() < q)) break;
@@ -257,7 +263,7 @@ PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, int u, int v, in
     BrdfCoefficientsOf<float, Float3>(sp.base, sp.roughness, sp.metallic, sp.specular, &c_diff, &f0,
                                       &alpha);
     const BsdfPod b = MakeBsdf(c_diff, f0, alpha, sp.n, sp.ng, Float3{-d.x, -d.y, -d.z});
-    PathNextEvent<kMedia>(pf, PathSurfaceVertex{&sp, &b}, beta, &rng, &L);
+    PathNextEvent<kMedia>(pf, tracer, PathSurfaceVertex{&sp, &b}, beta, &rng, &L);
 
     // Russian roulette, then continue along a BSDF sample.
     if (vertex >= kPathRussianRouletteStartVertex) {
@@ -291,14 +297,14 @@ struct PathPartial {
 };
 
 /// samples [s0, s1) of pixel (u, v) (TracePath<kMedia, kParticles>), summed in sample order.
-template <bool kMedia, bool kParticles = false>
-PB_HOST_DEVICE inline PathPartial PathSampleRange(const PathFrameView& pf, int u, int v, int s0,
-                                                  int s1) {
+template <bool kMedia, bool kParticles = false, class Tracer>
+PB_HOST_DEVICE inline PathPartial PathSampleRange(const PathFrameView& pf, const Tracer& tracer,
+                                                  int u, int v, int s0, int s1) {
   PathPartial p;
   for (int s = s0; s < s1; ++s) {
     Float3 albedo;
     bool hit = false;
-    const Float3 L = TracePath<kMedia, kParticles>(pf, u, v, s, &albedo, &hit);
+    const Float3 L = TracePath<kMedia, kParticles>(pf, tracer, u, v, s, &albedo, &hit);
     if (hit) {
       p.albedo[0] += albedo.x, p.albedo[1] += albedo.y, p.albedo[2] += albedo.z;
       ++p.albedo_count;
@@ -312,8 +318,9 @@ PB_HOST_DEVICE inline PathPartial PathSampleRange(const PathFrameView& pf, int u
 /// pixel (u, v)'s outputs from the sums of all its pf.spp samples: the mean radiance and
 /// albedo, and the pixel-centre ray's depth and usable shading normal (the CPU's denoiser
 /// guides: its depth image's ray, and its normal rule).
-PB_HOST_DEVICE inline void PathFinishPixel(const PathFrameView& pf, int u, int v,
-                                           const PathPartial& p) {
+template <class Tracer>
+PB_HOST_DEVICE inline void PathFinishPixel(const PathFrameView& pf, const Tracer& tracer, int u,
+                                           int v, const PathPartial& p) {
   const int64_t i = static_cast<int64_t>(v) * pf.rt.camera.width + u;
   const double spp = static_cast<double>(pf.spp);
   pf.radiance[i] = Float3{static_cast<float>(p.L[0] / spp), static_cast<float>(p.L[1] / spp),
@@ -324,7 +331,7 @@ PB_HOST_DEVICE inline void PathFinishPixel(const PathFrameView& pf, int u, int v
                                     : Float3{};
   const TraceRay r = PrimaryRay(pf.rt.camera, u, v);
   TraceHit h;
-  TraceClosest(pf.rt.scene, r, &h);
+  tracer.Closest(r, &h);
   if (h.instance < 0) {
     pf.depth[i] = 0;
     pf.normal[i] = Float3{};
@@ -339,13 +346,16 @@ PB_HOST_DEVICE inline void PathFinishPixel(const PathFrameView& pf, int u, int v
 /// pixel (u, v) of a pathtraced frame in one run: all pf.spp samples (PathSampleRange) summed in
 /// sample order in double, as the CPU's PathIntegrator sums them, then PathFinishPixel
 /// (TracePath<true, ...> where the frame has media, TracePath<..., true> where it has streaks).
-PB_HOST_DEVICE inline void PathTracePixel(const PathFrameView& pf, int u, int v) {
+template <class Tracer>
+PB_HOST_DEVICE inline void PathTracePixel(const PathFrameView& pf, const Tracer& tracer, int u,
+                                          int v) {
   const bool media = MediaAny(pf.media), particles = pf.streaks.num > 0;
-  PathFinishPixel(pf, u, v,
-                  particles ? (media ? PathSampleRange<true, true>(pf, u, v, 0, pf.spp)
-                                     : PathSampleRange<false, true>(pf, u, v, 0, pf.spp))
-                            : (media ? PathSampleRange<true>(pf, u, v, 0, pf.spp)
-                                     : PathSampleRange<false>(pf, u, v, 0, pf.spp)));
+  const int n = pf.spp;
+  PathFinishPixel(pf, tracer, u, v,
+                  particles ? (media ? PathSampleRange<true, true>(pf, tracer, u, v, 0, n)
+                                     : PathSampleRange<false, true>(pf, tracer, u, v, 0, n))
+                            : (media ? PathSampleRange<true>(pf, tracer, u, v, 0, n)
+                                     : PathSampleRange<false>(pf, tracer, u, v, 0, n)));
 }
 
 /// the sample runs of a frame of n pixels and spp samples on a processor that wants about
