@@ -43,7 +43,7 @@ void ToRowMajor(const Pose& X, float m[12]) {
   }
 }
 
-F3 ToF3(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
+F3 F3Of(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
 
@@ -83,7 +83,7 @@ void BvhScene::AddGeom(int gi, const Pose& X_IG, std::vector<PrimBox>* boxes, in
     for (size_t f = 0; f < shape.faces.size(); ++f) {
       const Eigen::Vector3i& face = shape.faces[f];
       const Eigen::Vector3f &a = v_I[face[0]], &b = v_I[face[1]], &c = v_I[face[2]];
-      Triangle tri{ToF3(a), ToF3(b - a), ToF3(c - a)};
+      Triangle tri{F3Of(a), F3Of(b - a), F3Of(c - a)};
       PrimRef ref;
       ref.kind = 0;
       ref.index = static_cast<int32_t>(triangles_.size());
@@ -91,7 +91,7 @@ void BvhScene::AddGeom(int gi, const Pose& X_IG, std::vector<PrimBox>* boxes, in
       if (normals || uv) {
         TriangleShading ts{};
         for (int k = 0; k < 3; ++k) {
-          if (normals) ts.n[k] = ToF3(terms.normals_I[face[k]]);
+          if (normals) ts.n[k] = F3Of(terms.normals_I[face[k]]);
           if (uv)
             ts.uv[k][0] = shape.texcoords[face[k]].x(), ts.uv[k][1] = shape.texcoords[face[k]].y();
         }

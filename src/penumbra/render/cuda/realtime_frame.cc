@@ -16,16 +16,16 @@
 namespace penumbra::cuda {
 namespace {
 
-Float3 ToFloat3(const Eigen::Vector3f& v) { return Float3{v.x(), v.y(), v.z()}; }
+Float3 Float3Of(const Eigen::Vector3f& v) { return Float3{v.x(), v.y(), v.z()}; }
 F3 FrameToF3(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
 
 MaterialPod PodOf(const Material& m, const std::vector<int>& texture_slot) {
   MaterialPod p;
-  p.base_color = ToFloat3(m.base_color);
+  p.base_color = Float3Of(m.base_color);
   p.roughness = m.roughness;
   p.metallic = m.metallic;
   p.specular = m.specular;
-  p.emission = ToFloat3(m.emission);
+  p.emission = Float3Of(m.emission);
   p.texture = m.texture >= 0 && m.texture < static_cast<int>(texture_slot.size())
                   ? texture_slot[m.texture]
                   : -1;
@@ -126,7 +126,7 @@ RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const Render
   for (size_t g = 0; g < scene.geoms.size(); ++g) {
     const Geom& geom = scene.geoms[g];
     GeomPod& pod = geoms_[g];
-    pod.half_extent = ToFloat3(GeomHalfExtents(scene, geom));
+    pod.half_extent = Float3Of(GeomHalfExtents(scene, geom));
     pod.plane = geom.shape == GeomShape::kPlane ? 1 : 0;
     pod.box = geom.shape == GeomShape::kBox ? 1 : 0;
   }
@@ -286,7 +286,7 @@ void RealtimeFrameData::SetSplatCamera(const Camera& camera) {
   const Pose X_OW = camera.X_WO().inverse();
   const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> R_OW = X_OW.linear().cast<float>();
   std::copy(R_OW.data(), R_OW.data() + 9, splat_camera_.R_OW);
-  splat_camera_.p_OW = ToFloat3(X_OW.translation().cast<float>());
+  splat_camera_.p_OW = Float3Of(X_OW.translation().cast<float>());
   const CameraIntrinsics& k = camera.intrinsics();
   splat_camera_.fx = k.fx;
   splat_camera_.fy = k.fy;
