@@ -239,6 +239,12 @@ struct RayScene::Impl {
           "the limits of docs/world-file.md (\"Input limits\")",
           ox, oy, oz, dx, dy, dz, kMaxRayComponent);
   }
+  // IsTraceableRay(r); a refused ray is noted (NoteUntraceable).
+  bool Traceable(const Ray& r) const {
+    if (IsTraceableRay(r)) return true;
+    NoteUntraceable(r.o.x(), r.o.y(), r.o.z(), r.d.x(), r.d.y(), r.d.z());
+    return false;
+  }
 
   void Check(const char* what) const {
     if (!error.empty()) throw Error(std::string("RayScene: ") + what + ": " + error);
@@ -546,12 +552,10 @@ struct RayScene::Impl {
       fill = -1;
       for (int k = 0; k < kPacket; ++k) {
         if (index[k] < 0) continue;
-        if (IsTraceableRay(rays[index[k]])) {
+        if (Traceable(rays[index[k]])) {
           fill = index[k];
           continue;
         }
-        const Ray& r = rays[index[k]];
-        NoteUntraceable(r.o.x(), r.o.y(), r.o.z(), r.d.x(), r.d.y(), r.d.z());
         did_hit[index[k]] = false;
         local_index[k] = -1;
       }
@@ -724,10 +728,7 @@ int64_t RayScene::num_untraceable_rays() const {
 }
 
 bool RayScene::Intersect(const Ray& ray, SurfaceHit* hit) const {
-  if (!IsTraceableRay(ray)) {
-    impl_->NoteUntraceable(ray.o.x(), ray.o.y(), ray.o.z(), ray.d.x(), ray.d.y(), ray.d.z());
-    return false;
-  }
+  if (!impl_->Traceable(ray)) return false;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh;
@@ -741,10 +742,7 @@ bool RayScene::Intersect(const Ray& ray, SurfaceHit* hit) const {
 }
 
 bool RayScene::Occluded(const Ray& ray) const {
-  if (!IsTraceableRay(ray)) {
-    impl_->NoteUntraceable(ray.o.x(), ray.o.y(), ray.o.z(), ray.d.x(), ray.d.y(), ray.d.z());
-    return false;
-  }
+  if (!impl_->Traceable(ray)) return false;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRay r;
