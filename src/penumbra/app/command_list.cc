@@ -2,6 +2,7 @@
 
 #include "penumbra/app/bench_commands.h"
 #include "penumbra/app/benchmark_command.h"
+#include "penumbra/app/compare_command.h"
 #include "penumbra/app/decompose_command.h"
 #include "penumbra/app/eval_command.h"
 #include "penumbra/app/export_command.h"
@@ -38,6 +39,7 @@ std::vector<std::unique_ptr<Command>> CommandList() {
   list.push_back(MakeViewCommand());
   list.push_back(MakeBenchSensorsCommand());
   list.push_back(std::make_unique<EvalCommand>());
+  list.push_back(MakeCompareCommand());
   list.push_back(std::make_unique<ExportCommand>());
   list.push_back(std::make_unique<ReplayCommand>());
   list.push_back(MakeBenchmarkCommand());
