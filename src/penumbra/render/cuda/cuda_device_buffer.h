@@ -1,8 +1,8 @@
 #pragma once
-// the CUDA backend's runtime helpers for its .cu files: error checks, a growing device
-// buffer, a growing page-locked host buffer, the host's copies of page-locked outputs into the
-// caller's images and event timing. includes the CUDA runtime header: only .cu files include
-// this.
+// the CUDA backend's runtime helpers for its .cu files: error checks, checked kernel launches,
+// a growing device buffer, a growing page-locked host buffer, the host's copies of page-locked
+// outputs into the caller's images and event timing. includes the CUDA runtime header: only .cu
+// files include this.
 
 #include <cuda_runtime.h>
 
@@ -23,21 +23,57 @@ inline void Check(cudaError_t e, const char* what) {
     throw Error(std::string("CUDA backend: ") + what + ": " + cudaGetErrorString(e));
 }
 
-/// a device buffer that grows (never shrinks) to the bytes asked for.
-struct Buffer {
+/// queues kernel<<<grid, block, shared_bytes, stream>>>(args...) and checks the launch
+/// (Check, naming `name`).
+template <typename... Params, typename... Args>
+void LaunchKernel(const char* name, void (*kernel)(Params...), dim3 grid, dim3 block,
+                  size_t shared_bytes, cudaStream_t stream, const Args&... args) {
+  kernel<<<grid, block, shared_bytes, stream>>>(args...);
+  Check(cudaGetLastError(), name);
+}
+
+/// memory that grows (never shrinks) to the bytes asked for, allocated and freed by `Memory`
+/// (DeviceMemory or PinnedMemory).
+template <class Memory>
+struct GrowingBuffer {
   void* p = nullptr;
   size_t bytes = 0;
-  Buffer() = default;
-  Buffer(const Buffer&) = delete;
-  Buffer& operator=(const Buffer&) = delete;
+  GrowingBuffer() = default;
+  GrowingBuffer(const GrowingBuffer&) = delete;
+  GrowingBuffer& operator=(const GrowingBuffer&) = delete;
   void Reserve(size_t n) {
     if (n <= bytes) return;
-    if (p) cudaFree(p);
+    if (p) Memory::Free(p);
     p = nullptr;
     bytes = 0;
-    Check(cudaMalloc(&p, n), "cudaMalloc");
+    Check(Memory::Allocate(&p, n), Memory::kAllocate);
     bytes = n;
   }
+  template <typename T>
+  T* as() const {
+    return static_cast<T*>(p);
+  }
+  ~GrowingBuffer() {
+    if (p) Memory::Free(p);
+  }
+};
+
+/// device memory (cudaMalloc).
+struct DeviceMemory {
+  static constexpr const char* kAllocate = "cudaMalloc";
+  static cudaError_t Allocate(void** p, size_t n) { return cudaMalloc(p, n); }
+  static void Free(void* p) { cudaFree(p); }
+};
+
+/// page-locked host memory (cudaMallocHost).
+struct PinnedMemory {
+  static constexpr const char* kAllocate = "cudaMallocHost";
+  static cudaError_t Allocate(void** p, size_t n) { return cudaMallocHost(p, n); }
+  static void Free(void* p) { cudaFreeHost(p); }
+};
+
+/// a device buffer that grows (never shrinks) to the bytes asked for.
+struct Buffer : GrowingBuffer<DeviceMemory> {
   /// copies n host bytes in on stream s (asynchronous for pinned memory).
   void Upload(const void* src, size_t n, cudaStream_t s) {
     Reserve(n > 0 ? n : 1);
@@ -47,38 +83,10 @@ struct Buffer {
   void Download(void* dst, size_t n, cudaStream_t s) const {
     if (n > 0) Check(cudaMemcpyAsync(dst, p, n, cudaMemcpyDeviceToHost, s), "cudaMemcpyAsync");
   }
-  template <typename T>
-  T* as() const {
-    return static_cast<T*>(p);
-  }
-  ~Buffer() {
-    if (p) cudaFree(p);
-  }
 };
 
 /// page-locked host memory that grows (never shrinks).
-struct PinnedBuffer {
-  void* p = nullptr;
-  size_t bytes = 0;
-  PinnedBuffer() = default;
-  PinnedBuffer(const PinnedBuffer&) = delete;
-  PinnedBuffer& operator=(const PinnedBuffer&) = delete;
-  void Reserve(size_t n) {
-    if (n <= bytes) return;
-    if (p) cudaFreeHost(p);
-    p = nullptr;
-    bytes = 0;
-    Check(cudaMallocHost(&p, n), "cudaMallocHost");
-    bytes = n;
-  }
-  template <typename T>
-  T* as() const {
-    return static_cast<T*>(p);
-  }
-  ~PinnedBuffer() {
-    if (p) cudaFreeHost(p);
-  }
-};
+using PinnedBuffer = GrowingBuffer<PinnedMemory>;
 
 /// one host copy of ParallelCopy.
 struct HostCopy {

@@ -117,9 +117,8 @@ void ExpRnOnDevice(const float* x, float* y, int64_t n) {
   dx.Upload(x, n * sizeof(float), nullptr);
   dy.Reserve(n * sizeof(float));
   const int block = 256;
-  ExpRnKernel<<<static_cast<unsigned>((n + block - 1) / block), block>>>(dx.as<float>(),
-                                                                         dy.as<float>(), n);
-  Check(cudaGetLastError(), "ExpRnKernel launch");
+  LaunchKernel("ExpRnKernel launch", ExpRnKernel, static_cast<unsigned>((n + block - 1) / block),
+               block, 0, 0, dx.as<float>(), dy.as<float>(), n);
   dy.Download(y, n * sizeof(float), nullptr);
   Check(cudaDeviceSynchronize(), "ExpRnKernel");
 }
@@ -225,9 +224,9 @@ void DeviceScene::Trace(const TraceRay* rays, int64_t n, TraceHit* hits) {
   m.rays.Upload(rays, n * sizeof(TraceRay), m.stream);
   m.hits.Reserve(n * sizeof(TraceHit));
   const int block = 128;
-  TraceKernel<<<static_cast<unsigned>((n + block - 1) / block), block, 0, m.stream>>>(
-      m.view, static_cast<const TraceRay*>(m.rays.p), n, static_cast<TraceHit*>(m.hits.p));
-  Check(cudaGetLastError(), "TraceKernel launch");
+  LaunchKernel("TraceKernel launch", TraceKernel, static_cast<unsigned>((n + block - 1) / block),
+               block, 0, m.stream, m.view, static_cast<const TraceRay*>(m.rays.p), n,
+               static_cast<TraceHit*>(m.hits.p));
   Check(cudaMemcpyAsync(hits, m.hits.p, n * sizeof(TraceHit), cudaMemcpyDeviceToHost, m.stream),
         "copying hits back");
   Check(cudaStreamSynchronize(m.stream), "TraceKernel");
@@ -239,9 +238,9 @@ void DeviceScene::Occluded(const TraceRay* rays, int64_t n, uint8_t* occluded) {
   m.rays.Upload(rays, n * sizeof(TraceRay), m.stream);
   m.hits.Reserve(n);
   const int block = 128;
-  OccludedKernel<<<static_cast<unsigned>((n + block - 1) / block), block, 0, m.stream>>>(
-      m.view, static_cast<const TraceRay*>(m.rays.p), n, static_cast<uint8_t*>(m.hits.p));
-  Check(cudaGetLastError(), "OccludedKernel launch");
+  LaunchKernel("OccludedKernel launch", OccludedKernel,
+               static_cast<unsigned>((n + block - 1) / block), block, 0, m.stream, m.view,
+               static_cast<const TraceRay*>(m.rays.p), n, static_cast<uint8_t*>(m.hits.p));
   Check(cudaMemcpyAsync(occluded, m.hits.p, n, cudaMemcpyDeviceToHost, m.stream),
         "copying occlusion back");
   Check(cudaStreamSynchronize(m.stream), "OccludedKernel");
@@ -301,8 +300,8 @@ void DeviceScene::RenderPrimary(const PinholeCamera& c, const PrimaryOutputs& wa
   const int band_rows = (c.height + bands - 1) / bands;
   const dim3 block(8, 8);
   Check(cudaEventRecord(m.primary_start, m.stream), "cudaEventRecord");
-  PrimaryKernel<<<dim3((c.width + 7) / 8, (c.height + 7) / 8), block, 0, m.stream>>>(m.view, c, d);
-  Check(cudaGetLastError(), "PrimaryKernel launch");
+  LaunchKernel("PrimaryKernel launch", PrimaryKernel, dim3((c.width + 7) / 8, (c.height + 7) / 8),
+               block, 0, m.stream, m.view, c, d);
   Check(cudaEventRecord(m.primary_traced, m.stream), "cudaEventRecord");
   {
     std::vector<HostCopy> copies;

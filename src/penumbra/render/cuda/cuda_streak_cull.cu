@@ -315,10 +315,9 @@ void DeviceStreakCull::Queue(const DropSet* sets, int32_t num_sets, const Streak
   m.totals.Reserve(sizeof(int32_t) * 4);
   constexpr int kBlock = 256;
   const int blocks = (n + kBlock - 1) / kBlock;
-  DecideDropsKernel<<<blocks, kBlock, 0, st>>>(d, f, m.kept.as<int32_t>(), m.culled.as<int32_t>(),
-                                               m.bad.as<int32_t>(), m.out.as<StreakCullOut>(),
-                                               m.set_of.as<int32_t>());
-  Check(cudaGetLastError(), "DecideDropsKernel");
+  LaunchKernel("DecideDropsKernel", DecideDropsKernel, blocks, kBlock, 0, st, d, f,
+               m.kept.as<int32_t>(), m.culled.as<int32_t>(), m.bad.as<int32_t>(),
+               m.out.as<StreakCullOut>(), m.set_of.as<int32_t>());
   // the scan and the two reductions (their temporary storage: the largest of the three)
   int32_t* totals = m.totals.as<int32_t>();
   size_t scan_bytes = 0, sum_bytes = 0, min_bytes = 0;
@@ -339,10 +338,9 @@ void DeviceStreakCull::Queue(const DropSet* sets, int32_t num_sets, const Streak
   Check(cub::DeviceReduce::Min(m.temp.p, min_bytes, m.bad.as<int32_t>(), totals + 2, n, st),
         "cub::DeviceReduce::Min");
   CountKernel<<<1, 1, 0, st>>>(m.kept.as<int32_t>(), m.at.as<int32_t>(), n, totals);
-  WriteStreaksKernel<<<blocks, kBlock, 0, st>>>(d, m.kept.as<int32_t>(), m.at.as<int32_t>(),
-                                                m.out.as<StreakCullOut>(), m.set_of.as<int32_t>(),
-                                                m.pods.as<StreakPod>());
-  Check(cudaGetLastError(), "WriteStreaksKernel");
+  LaunchKernel("WriteStreaksKernel", WriteStreaksKernel, blocks, kBlock, 0, st, d,
+               m.kept.as<int32_t>(), m.at.as<int32_t>(), m.out.as<StreakCullOut>(),
+               m.set_of.as<int32_t>(), m.pods.as<StreakPod>());
   // the counts back into page-locked memory (Finish reads them), then the event the frame's
   // stream waits for
   Check(cudaMemcpyAsync(m.totals_host.p, totals, sizeof(int32_t) * 3, cudaMemcpyDeviceToHost, st),

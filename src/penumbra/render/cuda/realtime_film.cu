@@ -94,45 +94,42 @@ __global__ void BatchDevelopKernel(const Float3* radiance, int64_t n, const Real
 
 void LaunchRowSums(const Float3* radiance, int W, int H, int cameras, double* rows,
                    cudaStream_t stream) {
-  RowSumWarpKernel<<<dim3((H + 3) / 4, cameras), 128, 0, stream>>>(radiance, W, H, rows);
-  Check(cudaGetLastError(), "RowSumWarpKernel");
+  LaunchKernel("RowSumWarpKernel", RowSumWarpKernel, dim3((H + 3) / 4, cameras), 128, 0, stream,
+               radiance, W, H, rows);
 }
 
 void LaunchExposure(const double* rows, int height, int64_t pixels, const FilmExposurePod& film,
                     const float gains[3], DeviceExposure* out, cudaStream_t stream) {
   const Exposure g{{gains[0], gains[1], gains[2]}};
-  ExposureKernel<<<1, 256, sizeof(double) * height, stream>>>(rows, height, pixels, film, g, out);
-  Check(cudaGetLastError(), "ExposureKernel");
+  LaunchKernel("ExposureKernel", ExposureKernel, 1, 256, sizeof(double) * height, stream, rows,
+               height, pixels, film, g, out);
 }
 
 void LaunchDevelop(const Float3* radiance, int64_t n, const float e[3], int filmic,
                    const uint8_t* lut, uint8_t* rgb, cudaStream_t stream) {
   const Exposure x{{e[0], e[1], e[2]}};
-  DevelopKernel<<<static_cast<unsigned>((n + 255) / 256), 256, 0, stream>>>(radiance, n, x, filmic,
-                                                                            lut, rgb);
-  Check(cudaGetLastError(), "DevelopKernel");
+  LaunchKernel("DevelopKernel", DevelopKernel, static_cast<unsigned>((n + 255) / 256), 256, 0,
+               stream, radiance, n, x, filmic, lut, rgb);
 }
 
 void LaunchDevelop(const Float3* radiance, int64_t n, const DeviceExposure* exposure, int filmic,
                    const uint8_t* lut, uint8_t* rgb, cudaStream_t stream) {
-  DevelopDeviceExposureKernel<<<static_cast<unsigned>((n + 255) / 256), 256, 0, stream>>>(
-      radiance, n, exposure, filmic, lut, rgb);
-  Check(cudaGetLastError(), "DevelopKernel");
+  LaunchKernel("DevelopKernel", DevelopDeviceExposureKernel, static_cast<unsigned>((n + 255) / 256),
+               256, 0, stream, radiance, n, exposure, filmic, lut, rgb);
 }
 
 void LaunchBatchExposure(const double* rows, int height, int64_t n, int count,
                          const RealtimeBatchFilm* film, DeviceExposure* exposure,
                          cudaStream_t stream) {
-  BatchExposureKernel<<<count, 256, sizeof(double) * height, stream>>>(rows, height, n, film,
-                                                                       exposure);
-  Check(cudaGetLastError(), "BatchExposureKernel");
+  LaunchKernel("BatchExposureKernel", BatchExposureKernel, count, 256, sizeof(double) * height,
+               stream, rows, height, n, film, exposure);
 }
 
 void LaunchBatchDevelop(const Float3* radiance, int64_t n, int count, const RealtimeBatchFilm* film,
                         const DeviceExposure* exposure, uint8_t* rgb, cudaStream_t stream) {
-  BatchDevelopKernel<<<dim3(static_cast<unsigned>((n + 255) / 256), count), 256, 0, stream>>>(
-      radiance, n, film, exposure, rgb);
-  Check(cudaGetLastError(), "BatchDevelopKernel");
+  LaunchKernel("BatchDevelopKernel", BatchDevelopKernel,
+               dim3(static_cast<unsigned>((n + 255) / 256), count), 256, 0, stream, radiance, n,
+               film, exposure, rgb);
 }
 
 }  // namespace realtime

@@ -67,38 +67,37 @@ __global__ void MirrorBlendKernel(Frames frames, Float3* radiance) {
 template <class Frames>
 void LaunchGeometry(Frames frames, dim3 grid, PixelGeometry* geometry, float* depth,
                     SurfaceTerms* surfaces, cudaStream_t stream) {
-  GeometryKernel<<<grid, PixelBlock(), 0, stream>>>(frames, geometry, depth, surfaces);
-  Check(cudaGetLastError(), "GeometryKernel");
+  LaunchKernel("GeometryKernel", GeometryKernel<Frames>, grid, PixelBlock(), 0, stream, frames,
+               geometry, depth, surfaces);
 }
 
 template <class Frames>
 void LaunchSkyQuads(Frames frames, dim3 quads, Float3* sky, cudaStream_t stream) {
-  SkyQuadKernel<<<quads, PixelBlock(), 0, stream>>>(frames, sky);
-  Check(cudaGetLastError(), "SkyQuadKernel");
+  LaunchKernel("SkyQuadKernel", SkyQuadKernel<Frames>, quads, PixelBlock(), 0, stream, frames, sky);
 }
 
 template <class Frames>
 void LaunchMirrorTrace(Frames frames, dim3 grid, cudaStream_t stream) {
-  MirrorTraceKernel<<<grid, PixelBlock(), 0, stream>>>(frames);
-  Check(cudaGetLastError(), "MirrorTraceKernel");
+  LaunchKernel("MirrorTraceKernel", MirrorTraceKernel<Frames>, grid, PixelBlock(), 0, stream,
+               frames);
 }
 
 template <class Frames>
 void LaunchMirrorSky(Frames frames, dim3 grid, Float3* mirror_sky, cudaStream_t stream) {
-  MirrorSkyKernel<<<grid, PixelBlock(), 0, stream>>>(frames, mirror_sky);
-  Check(cudaGetLastError(), "MirrorSkyKernel");
+  LaunchKernel("MirrorSkyKernel", MirrorSkyKernel<Frames>, grid, PixelBlock(), 0, stream, frames,
+               mirror_sky);
 }
 
 template <class Frames>
 void LaunchMirrorShade(Frames frames, dim3 grid, cudaStream_t stream) {
-  MirrorShadeKernel<<<grid, PixelBlock(), 0, stream>>>(frames);
-  Check(cudaGetLastError(), "MirrorShadeKernel");
+  LaunchKernel("MirrorShadeKernel", MirrorShadeKernel<Frames>, grid, PixelBlock(), 0, stream,
+               frames);
 }
 
 template <class Frames>
 void LaunchMirrorBlend(Frames frames, dim3 grid, Float3* radiance, cudaStream_t stream) {
-  MirrorBlendKernel<<<grid, PixelBlock(), 0, stream>>>(frames, radiance);
-  Check(cudaGetLastError(), "MirrorBlendKernel");
+  LaunchKernel("MirrorBlendKernel", MirrorBlendKernel<Frames>, grid, PixelBlock(), 0, stream,
+               frames, radiance);
 }
 
 #define PB_REALTIME_GEOMETRY(Frames)                                                        \

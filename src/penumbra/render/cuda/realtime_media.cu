@@ -258,9 +258,9 @@ void MediaStreakBuffers::BuildGridMedia(const RealtimeMediaView& h, RealtimeFram
   media_grid_T.Reserve(sizeof(float) * GridLightValues(h));
   media_grid_source.Reserve(sizeof(Float3) * static_cast<size_t>(cells > 0 ? cells : 1));
   if (cells > 0) {
-    MediaGridLightKernel<<<static_cast<unsigned>((cells + 63) / 64), 64, 0, stream>>>(
-        *f, cells, media_grid_T.as<float>(), media_grid_source.as<Float3>());
-    Check(cudaGetLastError(), "MediaGridLightKernel");
+    LaunchKernel("MediaGridLightKernel", MediaGridLightKernel,
+                 static_cast<unsigned>((cells + 63) / 64), 64, 0, stream, *f, cells,
+                 media_grid_T.as<float>(), media_grid_source.as<Float3>());
   }
   m.grid_light_T = media_grid_T.as<float>();
   const GridLightPod& last = h.grids[h.num_grids - 1];
@@ -273,10 +273,9 @@ void MediaStreakBuffers::BuildGridMedia(const RealtimeMediaView& h, RealtimeFram
   media_grid_records.Reserve(sizeof(GridFroxelRecord<Rgb4>) * static_cast<size_t>(columns) *
                              (kFroxelSlices + 1));
   float* cols = media_grid_columns.as<float>();
-  MediaGridFroxelKernel<<<static_cast<unsigned>(columns), kGridSliceBlock, 0, stream>>>(
-      *f, media_grid_source.as<Float3>(), cols, cols + columns, cols + 2 * columns,
-      media_grid_records.as<GridFroxelRecord<Rgb4>>());
-  Check(cudaGetLastError(), "MediaGridFroxelKernel");
+  LaunchKernel("MediaGridFroxelKernel", MediaGridFroxelKernel, static_cast<unsigned>(columns),
+               kGridSliceBlock, 0, stream, *f, media_grid_source.as<Float3>(), cols, cols + columns,
+               cols + 2 * columns, media_grid_records.as<GridFroxelRecord<Rgb4>>());
   m.grid_t0 = cols;
   m.grid_t1 = cols + columns;
   m.grid_slices_per_m = cols + 2 * columns;
@@ -299,18 +298,18 @@ void MediaStreakBuffers::BuildMedia(const RealtimeMediaView& h, RealtimeFrameVie
       media_vis.Reserve(bytes > 0 ? bytes : 4);
       vis = media_vis.as<float>();
     }
-    MediaLightVolumeKernel<<<static_cast<unsigned>((cells + 127) / 128), 128, 0, stream>>>(
-        *f, cells, media_trans.as<float>(), vis);
-    Check(cudaGetLastError(), "MediaLightVolumeKernel");
+    LaunchKernel("MediaLightVolumeKernel", MediaLightVolumeKernel,
+                 static_cast<unsigned>((cells + 127) / 128), 128, 0, stream, *f, cells,
+                 media_trans.as<float>(), vis);
     m.light_trans = media_trans.as<float>();
   }
   if (b.fog != 0) {
     const int columns = m.fog_nx * m.fog_ny;
     media_fog.Reserve(sizeof(Rgb4) * static_cast<size_t>(columns) * (kFogFroxelSlices + 1));
     media_inv_log_far.Reserve(sizeof(float) * static_cast<size_t>(columns));
-    MediaFogSliceKernel<<<static_cast<unsigned>(columns), kFogSliceBlock, 0, stream>>>(
-        *f, vis, media_fog.as<Rgb4>(), media_inv_log_far.as<float>());
-    Check(cudaGetLastError(), "MediaFogSliceKernel");
+    LaunchKernel("MediaFogSliceKernel", MediaFogSliceKernel, static_cast<unsigned>(columns),
+                 kFogSliceBlock, 0, stream, *f, vis, media_fog.as<Rgb4>(),
+                 media_inv_log_far.as<float>());
     m.fog_S = media_fog.as<Rgb4>();
     m.fog_inv_log_far = media_inv_log_far.as<float>();
   }
@@ -327,10 +326,9 @@ void LaunchStreakSplat(const RealtimeFrameView& f, cudaStream_t stream) {
   const int64_t warps = sp.count != nullptr ? std::min<int64_t>(sp.streaks.num, kSplatWarps)
                                             : static_cast<int64_t>(sp.streaks.num);
   const int64_t threads = 32 * warps;
-  StreakSplatKernel<<<static_cast<unsigned>((threads + 127) / 128), 128, 0, stream>>>(f);
-  Check(cudaGetLastError(), "StreakSplatKernel");
-  StreakShadeKernel<<<PixelGrid(W, H), PixelBlock(), 0, stream>>>(f);
-  Check(cudaGetLastError(), "StreakShadeKernel");
+  LaunchKernel("StreakSplatKernel", StreakSplatKernel, static_cast<unsigned>((threads + 127) / 128),
+               128, 0, stream, f);
+  LaunchKernel("StreakShadeKernel", StreakShadeKernel, PixelGrid(W, H), PixelBlock(), 0, stream, f);
 }
 
 void MediaStreakBuffers::QueueStreaks(const RealtimeFrameView& h, RealtimeFrameView* f, int64_t n,
@@ -380,19 +378,17 @@ void LaunchViewPasses(const RealtimeFrameView& f, const float* depth, Float3* ra
   const int W = f.camera.width, H = f.camera.height;
   if (f.has_media != 0) {
     // the streaks seen through the media too
-    MediaViewKernel<<<PixelGrid((W + 1) / 2, (H + 1) / 2), PixelBlock(), 0, stream>>>(f, depth,
-                                                                                      radiance);
-    Check(cudaGetLastError(), "MediaViewKernel");
+    LaunchKernel("MediaViewKernel", MediaViewKernel, PixelGrid((W + 1) / 2, (H + 1) / 2),
+                 PixelBlock(), 0, stream, f, depth, radiance);
     return;
   }
   if (f.num_streaks > 0) {
-    StreakKernel<<<static_cast<unsigned>((f.num_streaks + 255) / 256), 256, 0, stream>>>(
-        f.streaks, f.num_streaks, depth, radiance);
-    Check(cudaGetLastError(), "StreakKernel");
+    LaunchKernel("StreakKernel", StreakKernel, static_cast<unsigned>((f.num_streaks + 255) / 256),
+                 256, 0, stream, f.streaks, f.num_streaks, depth, radiance);
   }
   if (f.splat.streaks.num > 0) {
-    StreakSplatApplyKernel<<<PixelGrid(W, H), PixelBlock(), 0, stream>>>(f, depth, radiance);
-    Check(cudaGetLastError(), "StreakSplatApplyKernel");
+    LaunchKernel("StreakSplatApplyKernel", StreakSplatApplyKernel, PixelGrid(W, H), PixelBlock(), 0,
+                 stream, f, depth, radiance);
   }
 }
 

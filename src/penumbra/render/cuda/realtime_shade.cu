@@ -136,13 +136,12 @@ void LaunchQueued(Frames frames, dim3 grid, const SurfaceTerms* surfaces, Float3
                   const ShadowRayQueue& q, int row0, int row1, int64_t pixels, int term_lights,
                   size_t smem, cudaStream_t stream) {
   Check(cudaMemsetAsync(q.count, 0, sizeof(unsigned), stream), "cudaMemsetAsync");
-  ShadeQueuedKernel<Frames, kMedia, kSharedTerms>
-      <<<grid, PixelBlock(), smem, stream>>>(frames, surfaces, L, q, row0, row1, term_lights);
-  Check(cudaGetLastError(), "ShadeQueuedKernel");
-  TraceQueuedKernel<<<TraceQueuedBlocks<Frames>(), 128, 0, stream>>>(frames, q, pixels);
-  Check(cudaGetLastError(), "TraceQueuedKernel");
-  SumQueuedKernel<<<grid, PixelBlock(), 0, stream>>>(frames, L, q, row0, row1);
-  Check(cudaGetLastError(), "SumQueuedKernel");
+  LaunchKernel("ShadeQueuedKernel", ShadeQueuedKernel<Frames, kMedia, kSharedTerms>, grid,
+               PixelBlock(), smem, stream, frames, surfaces, L, q, row0, row1, term_lights);
+  LaunchKernel("TraceQueuedKernel", TraceQueuedKernel<Frames>, TraceQueuedBlocks<Frames>(), 128, 0,
+               stream, frames, q, pixels);
+  LaunchKernel("SumQueuedKernel", SumQueuedKernel<Frames>, grid, PixelBlock(), 0, stream, frames, L,
+               q, row0, row1);
 }
 
 // the frame's shared-terms kernels may take up to kShadeCachedLights lights' terms (set once)
@@ -198,13 +197,10 @@ void LaunchFrameShade(const RealtimeFrameView& f, const SurfaceTerms* surfaces, 
                                           smem, stream);
     return;
   }
-  if (media)
-    ShadeStoredKernel<OneFrame, true, true>
-        <<<grid, PixelBlock(), smem, stream>>>(fr, surfaces, L, row0, row1, lights);
-  else
-    ShadeStoredKernel<OneFrame, false, true>
-        <<<grid, PixelBlock(), smem, stream>>>(fr, surfaces, L, row0, row1, lights);
-  Check(cudaGetLastError(), "ShadeStoredKernel");
+  LaunchKernel(
+      "ShadeStoredKernel",
+      media ? ShadeStoredKernel<OneFrame, true, true> : ShadeStoredKernel<OneFrame, false, true>,
+      grid, PixelBlock(), smem, stream, fr, surfaces, L, row0, row1, lights);
 }
 
 void LaunchBatchShade(BatchFrames frames, int W, int H, int cameras, const SurfaceTerms* surfaces,
@@ -215,9 +211,8 @@ void LaunchBatchShade(BatchFrames frames, int W, int H, int cameras, const Surfa
                                             static_cast<int64_t>(W) * H, 0, 0, stream);
     return;
   }
-  ShadeStoredKernel<BatchFrames, false, false>
-      <<<grid, PixelBlock(), 0, stream>>>(frames, surfaces, L, 0, H, 0);
-  Check(cudaGetLastError(), "ShadeStoredKernel (batch)");
+  LaunchKernel("ShadeStoredKernel (batch)", ShadeStoredKernel<BatchFrames, false, false>, grid,
+               PixelBlock(), 0, stream, frames, surfaces, L, 0, H, 0);
 }
 
 }  // namespace penumbra::cuda::realtime

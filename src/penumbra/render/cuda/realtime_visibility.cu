@@ -388,8 +388,8 @@ void LaunchPenumbraRays(Frames frames, int W, int H, int lights, int64_t nl, int
   }
   Check(cudaGetLastError(), "VisibilityRaysWarpKernel");
   // one wave of resident blocks strides over the chunks (their number stays on the device)
-  VisibilityChunkKernel<<<ChunkBlocks<Frames>(), 128, 0, stream>>>(frames, q);
-  Check(cudaGetLastError(), "VisibilityChunkKernel");
+  LaunchKernel("VisibilityChunkKernel", VisibilityChunkKernel<Frames>, ChunkBlocks<Frames>(), 128,
+               0, stream, frames, q);
 }
 
 template <class Frames>
@@ -398,13 +398,9 @@ void LaunchVisibilityTiles(Frames frames, int W, int row0, int row1, int cameras
   if (row1 <= row0) return;
   dim3 grid = TileGrid(W, row0, row1);
   grid.z = cameras;
-  if (mirror)
-    VisibilityTileKernel<Frames, true>
-        <<<grid, TileBlock(), 0, stream>>>(frames, radiance, row0, row1);
-  else
-    VisibilityTileKernel<Frames, false>
-        <<<grid, TileBlock(), 0, stream>>>(frames, radiance, row0, row1);
-  Check(cudaGetLastError(), "VisibilityTileKernel");
+  LaunchKernel("VisibilityTileKernel",
+               mirror ? VisibilityTileKernel<Frames, true> : VisibilityTileKernel<Frames, false>,
+               grid, TileBlock(), 0, stream, frames, radiance, row0, row1);
 }
 
 template void LaunchPenumbraRays<OneFrame>(OneFrame, int, int, int, int64_t, int, int, void*, void*,
