@@ -60,13 +60,23 @@ struct PrimaryTimes {
 /// semantic_class (primary_pixel.h's planes, here in host memory).
 using PrimaryOutputs = PixelTruthPlanes;
 
+/// a base of the device classes (DeviceScene, DeviceRealtime, ...): they own device memory,
+/// streams and events, so they are neither copied nor assigned.
+class NonCopyable {
+ public:
+  NonCopyable(const NonCopyable&) = delete;
+  NonCopyable& operator=(const NonCopyable&) = delete;
+
+ protected:
+  NonCopyable() = default;
+  ~NonCopyable() = default;
+};
+
 /// the device copy of a BvhScene, its staging buffers and a stream.
-class DeviceScene {
+class DeviceScene : NonCopyable {
  public:
   DeviceScene();
   ~DeviceScene();
-  DeviceScene(const DeviceScene&) = delete;
-  DeviceScene& operator=(const DeviceScene&) = delete;
 
   /// the sizes of a SceneView's arrays.
   struct Sizes {

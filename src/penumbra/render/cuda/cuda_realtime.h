@@ -160,7 +160,7 @@ double DeviceFrameExposure(const FilmExposurePod& film, const std::vector<double
 /// alone. each camera's exposure is computed on the device from its row sums (one block a
 /// camera: film_math.h's FrameExposure over the rows in row order, the function the host's
 /// RealtimeFrameData::Ev100 calls; no atomics), so a batch never waits for the host.
-class RealtimeBatch {
+class RealtimeBatch : NonCopyable {
  public:
   /// working buffers for batches of up to max_cameras cameras of width x height pixels
   /// (height <= kMaxDeviceExposureRows) and `max_lights` lights, with the mirror layer's if
@@ -168,8 +168,6 @@ class RealtimeBatch {
   /// @throws Error for a bad size or count, or if the CUDA runtime fails.
   RealtimeBatch(int width, int height, int max_cameras, int max_lights, bool mirror, int slots);
   ~RealtimeBatch();
-  RealtimeBatch(const RealtimeBatch&) = delete;
-  RealtimeBatch& operator=(const RealtimeBatch&) = delete;
 
   /// enqueues on `stream` (a cudaStream_t) the realtime frames of cameras[0 .. count):
   /// frames[k] (host array) is camera k's frame with device pointers (DeviceRealtime::DeviceFrame
@@ -200,12 +198,10 @@ struct GridVolumeArrays {
   std::vector<GridFroxelRecord<Rgb4>> records;  ///< [column][boundary 0 .. kFroxelSlices]
 };
 
-class DeviceRealtime {
+class DeviceRealtime : NonCopyable {
  public:
   DeviceRealtime();
   ~DeviceRealtime();
-  DeviceRealtime(const DeviceRealtime&) = delete;
-  DeviceRealtime& operator=(const DeviceRealtime&) = delete;
 
   /// copies the scene-constant data to the device.
   void Upload(const RealtimeStatic& data);

@@ -31,12 +31,10 @@ struct DropSet {
 
 /// a frame's drop culling on the device; its buffers grow as needed and are kept between
 /// frames. not thread-safe.
-class DeviceStreakCull {
+class DeviceStreakCull : NonCopyable {
  public:
   DeviceStreakCull();
   ~DeviceStreakCull();
-  DeviceStreakCull(const DeviceStreakCull&) = delete;
-  DeviceStreakCull& operator=(const DeviceStreakCull&) = delete;
 
   /// decides every drop of the num_sets `sets` (host arrays; set s has the flags flags[s]) by
   /// `frame` (ParticleStreaks' StreakCullSetup of this frame: its media and shelter roof, host
