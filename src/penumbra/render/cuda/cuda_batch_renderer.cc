@@ -282,59 +282,41 @@ std::span<const BatchCamera> BatchRenderer::WithRayTables(std::span<const BatchC
   return patched_;
 }
 
-void BatchRenderer::CheckTicket(int64_t ticket) const {
+int BatchRenderer::CheckedSlot(int64_t ticket) const {
   if (!tickets_.Readable(ticket))
     throw Error(fmt::format(
         "batch rendering: ticket {}; expected one of the last {} submitted (of {}): a batch's "
         "images are overwritten when the batch {} later is submitted",
         ticket, BatchTickets::kSlots, tickets_.taken(), BatchTickets::kSlots));
+  return BatchTickets::SlotOf(ticket);
 }
 
 BatchImages BatchRenderer::Wait(int64_t ticket) {
-  CheckTicket(ticket);
-  const int slot = BatchTickets::SlotOf(ticket);
-  BatchImages img;
-  img.base = device_->Wait(slot);
-  img.layout = &layout_;
-  img.cameras = counts_[slot];
-  return img;
+  const int slot = CheckedSlot(ticket);
+  return BatchImages{device_->Wait(slot), &layout_, counts_[slot]};
 }
 
 BatchImages BatchRenderer::DeviceImages(int64_t ticket) const {
-  CheckTicket(ticket);
-  const int slot = BatchTickets::SlotOf(ticket);
-  BatchImages img;
-  img.base = device_->device_buffer(slot);
-  img.layout = &layout_;
-  img.cameras = counts_[slot];
-  img.on_device = true;
-  return img;
+  const int slot = CheckedSlot(ticket);
+  return BatchImages{device_->device_buffer(slot), &layout_, counts_[slot], true};
 }
 
 void* BatchRenderer::ready_event(int64_t ticket) const {
-  CheckTicket(ticket);
-  return device_->kernel_event(BatchTickets::SlotOf(ticket));
+  return device_->kernel_event(CheckedSlot(ticket));
 }
 
 double BatchRenderer::kernel_ms(int64_t ticket) const {
-  CheckTicket(ticket);
-  return device_->kernel_ms(BatchTickets::SlotOf(ticket));
+  return device_->kernel_ms(CheckedSlot(ticket));
 }
 
-double BatchRenderer::alone_ms(int64_t ticket) const {
-  CheckTicket(ticket);
-  return alone_ms_[BatchTickets::SlotOf(ticket)];
-}
+double BatchRenderer::alone_ms(int64_t ticket) const { return alone_ms_[CheckedSlot(ticket)]; }
 
-int BatchRenderer::alone_cameras(int64_t ticket) const {
-  CheckTicket(ticket);
-  return alone_count_[BatchTickets::SlotOf(ticket)];
-}
+int BatchRenderer::alone_cameras(int64_t ticket) const { return alone_count_[CheckedSlot(ticket)]; }
 
 RealtimeBatchTimes BatchRenderer::stage_ms(int64_t ticket) const {
-  CheckTicket(ticket);
+  const int slot = CheckedSlot(ticket);
   if (!realtime_) throw Error("batch rendering: stage times of a batch without rgb");
-  return realtime_->times(BatchTickets::SlotOf(ticket));
+  return realtime_->times(slot);
 }
 
 BatchCamera BatchRenderer::CameraOf(int world, const CameraView& view) {

@@ -205,7 +205,9 @@ class BatchRenderer {
     EffectsFrame effects;
     std::unique_ptr<CudaRenderer> single;
   };
-  void CheckTicket(int64_t ticket) const;
+  // the slot of `ticket` (BatchTickets::SlotOf); throws Error unless the ticket's images are
+  // still readable (one of the last BatchTickets::kSlots submitted).
+  int CheckedSlot(int64_t ticket) const;
   // `batch` with its cameras' ray tables copied to `slot`'s device buffer and their xy and
   // rows pointing there (in patched_); `batch` itself when no camera has tables.
   std::span<const BatchCamera> WithRayTables(std::span<const BatchCamera> batch, int slot);

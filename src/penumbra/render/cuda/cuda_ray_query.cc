@@ -7,6 +7,20 @@
 #include "penumbra/render/cuda/bvh_ray_query.h"
 
 namespace penumbra::cuda {
+namespace {
+
+// the traversal's form of each ray; an untraceable ray is a miss, traced as an empty segment
+// (tmax < tmin).
+std::vector<TraceRay> TraceRaysOf(std::span<const Ray> rays) {
+  std::vector<TraceRay> in(rays.size());
+  for (size_t i = 0; i < rays.size(); ++i) {
+    in[i] = ToTraceRay(rays[i]);
+    if (!IsTraceableRay(rays[i])) in[i] = {{0, 0, 0}, {0, 0, 1}, 1, 0};
+  }
+  return in;
+}
+
+}  // namespace
 
 void SyncDevice(const BvhScene& scene, DeviceScene* device, bool wait) {
   DeviceScene::Sizes n;
@@ -40,12 +54,7 @@ void CudaRayQuery::Update(const WorldSnapshot& snapshot) {
 
 void CudaRayQuery::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
                                   std::span<bool> did_hit) const {
-  // untraceable rays are misses: traced as empty segments (tmax < tmin)
-  std::vector<TraceRay> in(rays.size());
-  for (size_t i = 0; i < rays.size(); ++i) {
-    in[i] = ToTraceRay(rays[i]);
-    if (!IsTraceableRay(rays[i])) in[i] = {{0, 0, 0}, {0, 0, 1}, 1, 0};
-  }
+  const std::vector<TraceRay> in = TraceRaysOf(rays);
   std::vector<TraceHit> out(rays.size());
   // one batch at a time on the device; the hits are finished outside the lock, so that the
   // threads of a parallel caller (the sky irradiance volume's build) finish theirs together
@@ -60,11 +69,7 @@ void CudaRayQuery::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHi
 }
 
 void CudaRayQuery::OccludedBatch(std::span<const Ray> rays, std::span<bool> occluded) const {
-  std::vector<TraceRay> in(rays.size());
-  for (size_t i = 0; i < rays.size(); ++i) {
-    in[i] = ToTraceRay(rays[i]);
-    if (!IsTraceableRay(rays[i])) in[i] = {{0, 0, 0}, {0, 0, 1}, 1, 0};
-  }
+  const std::vector<TraceRay> in = TraceRaysOf(rays);
   std::vector<uint8_t> out(rays.size());
   {
     const std::lock_guard<std::mutex> lock(mutex_);
