@@ -19,7 +19,8 @@
 //    shadow ray its in-scatter source asks, then the source (the sky, and each light seen);
 //  - the grid froxels, one column at a time (GridFroxelColumnInterval, then per slice
 //    GridFroxelSlice and GridFroxelRecords, which accumulates the slices in slice order).
-// operation order: the CPU's, bit for bit (the rule of shading_math.h; docs/gpu-notes.md,
+// operation order: the CPU's, bit for bit (the rule of shading_math.h;
+// docs/journal/2026-11-26-gpu-effects.md,
 // "Media volumes built on the GPU" and "Grid media volumes built on the GPU").
 
 #include <stdint.h>

@@ -26,7 +26,8 @@
 //    composed of the functions above, a pixel's view segment (IntegrateView, per pixel or with a
 //    quad's shared lookups) and a surface point's transmittance to a light (the CPU realtime
 //    surface loop's); RealtimeMedia's member functions call these.
-// operation order: the CPU's, bit for bit (the rule of shading_math.h; docs/gpu-notes.md,
+// operation order: the CPU's, bit for bit (the rule of shading_math.h;
+// docs/journal/2026-11-26-gpu-effects.md,
 // "Homogeneous media").
 //
 // record types: the froxel lookups are templates over their record type R, an rgb value with a
