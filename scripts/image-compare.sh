@@ -110,7 +110,7 @@ fi
 if [[ -z $out ]]; then out=$(mktemp -d -t image-compare.XXXXXX); fi
 mkdir -p "$out/old" "$out/new"
 
-run_args=(--force --duration 0.05 --outputs rgb,depth,segmentation --threads 2 --backend cpu --tier "$tier" -q)
+run_args=(--force --duration 0.05 --outputs "rgb,depth,segmentation" --threads 2 --backend cpu --tier "$tier" -q)
 [[ -n $spp ]] && run_args+=(--spp "$spp")
 
 # run BIN on world file F into DIR; 0 when it ran and every camera wrote an rgb PNG
