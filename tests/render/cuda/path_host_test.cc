@@ -303,7 +303,7 @@ TEST_P(PathtracedHostParticles, TracksTheCpuBackendsEstimate) {
   EffectsPathFrame e;
   PrepareEffectsPath(c, &pool, &e);
   const cuda::RealtimeFrameData& data = *e.data;
-  EXPECT_TRUE(data.streaks().empty());  // no realtime streak pixels for the paths
+  EXPECT_EQ(data.splat_streaks().View().num, 0);  // no realtime splat streaks for the paths
   const cuda::PathStreaks streaks = data.path_streaks().View();
   ASSERT_GT(streaks.num, 0);
   const RenderedFrame& want = e.want;

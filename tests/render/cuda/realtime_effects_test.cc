@@ -57,11 +57,6 @@ class HostAndCpu {
     return c;
   }
 
-  // the GPU path alone.
-  RenderedFrame RenderHost(const CameraView& view, const EffectsFrame* fx) {
-    return host_.Render(view, fx);
-  }
-
   // the GPU path alone under fx without its particles.
   RenderedFrame RenderWithoutParticles(const CameraView& view, const EffectsFrame& fx) {
     EffectsFrame no_particles = fx;
@@ -94,6 +89,30 @@ void StreakPixelErrors(const std::vector<cuda::StreakPixel>& streaks, const Host
       *err += std::abs(c.cpu.radiance.data[i] - c.host.radiance.data[i]);
       *bare_err += std::abs(c.cpu.radiance.data[i] - bare.radiance.data[i]);
     }
+}
+
+// the streak pixels of the frame `data` was Prepared for, as the frame's splat keys them
+// (SplatProjection, SplatStreakRow): each keyed pixel with its nearest streak's t and coverage,
+// in pixel order.
+std::vector<cuda::StreakPixel> SplatPixels(const cuda::RealtimeFrameData& data, int W, int H) {
+  cuda::RealtimeFrameView f = data.View(cuda::SceneView(), nullptr);
+  const cuda::PathStreaks& list = f.splat.streaks;
+  std::vector<unsigned long long> nearest(static_cast<size_t>(W) * H, kNoStreakKey);
+  f.splat.nearest = nearest.data();
+  for (int k = 0; k < list.num; ++k) {
+    const StreakProjection p = cuda::SplatProjection(f, list.streaks[k]);
+    for (int v = p.v0; v <= p.v1 && !p.empty(); ++v) cuda::SplatStreakRow(f, k, p, v);
+  }
+  std::vector<cuda::StreakPixel> pixels;
+  for (size_t i = 0; i < nearest.size(); ++i) {
+    if (nearest[i] == kNoStreakKey) continue;
+    cuda::StreakPixel s;
+    s.pixel = static_cast<int64_t>(i);
+    s.t = StreakKeyT(nearest[i]);
+    s.alpha = list.streaks[StreakKeyIndex(nearest[i])].alpha;
+    pixels.push_back(s);
+  }
+  return pixels;
 }
 
 struct HostEffectsWorld {
@@ -131,9 +150,9 @@ INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeHostPathEffects,
                                            HostEffectsWorld{"effects/sun.yaml", 1.0}));
 
 // the particles of the rain and snow worlds at 1 s (the rover's camera, 160x120; rain also
-// wets the ground): each pixel's nearest streak found and shaded on the host by the CPU's
-// ParticleStreaks and drawn over the GPU path's radiance (ApplyStreak) gives the CPU backend's
-// image (PSNR >= 40 dB); on the streaks' pixels the GPU path without them is far from it.
+// wets the ground): the streaks splatted and shaded by the frame itself (StreakSplatView) give
+// the CPU backend's image (PSNR >= 40 dB); on the streaks' pixels (SplatPixels) the GPU path
+// without them is far from it.
 TEST(RealtimeHostPathEffectsFrames, ParticleStreaksMatchCpuBackend) {
   for (const char* file : {"effects/rain.yaml", "effects/snow.yaml"}) {
     SCOPED_TRACE(file);
@@ -143,12 +162,11 @@ TEST(RealtimeHostPathEffectsFrames, ParticleStreaksMatchCpuBackend) {
     HostAndCpu rig(scene, snap);
     const HostCompared c = rig.Compare(view, fx.get());
     const RenderedFrame bare = rig.RenderWithoutParticles(view, *fx);
-    // the streak pixels of the frame (the host splat's list: the device splat finds the same,
-    // DeviceSplatGivesTheHostSplatsImageByteForByte)
+    // the streak pixels of the frame
     cuda::RealtimeFrameData& data = rig.data();
-    data.set_device_streaks(false);
     data.Prepare(snap, view, &rig.pool(), fx.get());
-    const std::vector<cuda::StreakPixel>& streaks = data.streaks();
+    const std::vector<cuda::StreakPixel> streaks =
+        SplatPixels(data, view.intrinsics.width, view.intrinsics.height);
     double err = 0, bare_err = 0;
     StreakPixelErrors(streaks, c, bare, &err, &bare_err);
     std::printf(
@@ -165,15 +183,12 @@ TEST(RealtimeHostPathEffectsFrames, ParticleStreaksMatchCpuBackend) {
   }
 }
 
-// the realtime particle streaks splatted and shaded by the frame itself (the
-// default: StreakSplatView, here on the CPU by RenderRealtimeOnHost, the kernels' functions)
-// give the host splat's image (RealtimeFrameData::set_device_streaks(false): the CPU's
-// ParticleStreaks splat, PrecomputeRain and Shade, as before) byte for byte: rain and snow (the
-// rover's camera, shelter and rain culling) and fire (sparks seen through the fire's grid
-// media: MediaViewQuad) at 1 s, 160x120. the splat's keys give every pixel the host's nearest
-// streak (the same pixels, t and coverage); two renders are bit-identical; the frame without
-// its particles differs (so the comparison can fail).
-TEST(RealtimeHostPathEffectsFrames, DeviceSplatGivesTheHostSplatsImageByteForByte) {
+// the realtime particle streaks splatted and shaded by the frame itself (StreakSplatView, here
+// on the CPU by RenderRealtimeOnHost, the kernels' functions): rain and snow (the rover's camera,
+// shelter and rain culling) and fire (sparks seen through the fire's grid media: MediaViewQuad)
+// at 1 s, 160x120. the splat keys streak pixels, two renders are bit-identical and the frame
+// without its particles differs on some pixels.
+TEST(RealtimeHostPathEffectsFrames, FrameSplatDrawsTheStreaksWithTheSameBitsTwice) {
   for (const char* file : {"effects/rain.yaml", "effects/snow.yaml", "effects/fire.yaml"}) {
     SCOPED_TRACE(file);
     const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(file, 1.0, 160, 120);
@@ -183,37 +198,12 @@ TEST(RealtimeHostPathEffectsFrames, DeviceSplatGivesTheHostSplatsImageByteForByt
     bvh.Update(snap);
     ThreadPool pool(0);
     cuda::RealtimeFrameData data(scene, RenderSettings());
-    RenderedFrame host, device, again, bare;
-    data.set_device_streaks(false);
+    RenderedFrame device, again, bare;
     data.Prepare(snap, view, &pool, fx.get());
-    cuda::RenderRealtimeOnHost(data, bvh, &pool, &host, /*stored_surface=*/true);
-    const std::vector<cuda::StreakPixel> host_pixels = data.streaks();
-    ASSERT_EQ(data.splat_streaks().View().num, 0);
-    data.set_device_streaks(true);
-    data.Prepare(snap, view, &pool, fx.get());
-    EXPECT_TRUE(data.streaks().empty());
     cuda::RenderRealtimeOnHost(data, bvh, &pool, &device, /*stored_surface=*/true);
     cuda::RenderRealtimeOnHost(data, bvh, &pool, &again, /*stored_surface=*/true);
-    // the splat's keys, as RenderRealtimeOnHost makes them
-    const int W = view.intrinsics.width, H = view.intrinsics.height;
-    cuda::RealtimeFrameView f = data.View(bvh.view(), nullptr);
-    const cuda::PathStreaks& list = f.splat.streaks;
-    ASSERT_GT(list.num, 0);
-    std::vector<unsigned long long> nearest(static_cast<size_t>(W) * H, kNoStreakKey);
-    f.splat.nearest = nearest.data();
-    for (int k = 0; k < list.num; ++k) {
-      const StreakProjection p = cuda::SplatProjection(f, list.streaks[k]);
-      for (int v = p.v0; v <= p.v1 && !p.empty(); ++v) cuda::SplatStreakRow(f, k, p, v);
-    }
-    size_t keyed = 0;
-    for (unsigned long long key : nearest) keyed += key != kNoStreakKey ? 1 : 0;
-    EXPECT_EQ(keyed, host_pixels.size());
-    for (const cuda::StreakPixel& s : host_pixels) {
-      const unsigned long long key = nearest[s.pixel];
-      ASSERT_NE(key, kNoStreakKey) << "pixel " << s.pixel;
-      EXPECT_EQ(StreakKeyT(key), s.t) << "pixel " << s.pixel;
-      EXPECT_EQ(list.streaks[StreakKeyIndex(key)].alpha, s.alpha) << "pixel " << s.pixel;
-    }
+    const int num = data.splat_streaks().View().num;
+    const size_t keyed = SplatPixels(data, view.intrinsics.width, view.intrinsics.height).size();
     EffectsFrame no_particles = *fx;
     no_particles.particles.clear();
     data.Prepare(snap, view, &pool, &no_particles);
@@ -222,19 +212,16 @@ TEST(RealtimeHostPathEffectsFrames, DeviceSplatGivesTheHostSplatsImageByteForByt
     for (size_t i = 0; i < bare.radiance.data.size(); i += 3)
       changed += std::memcmp(&bare.radiance.data[i], &device.radiance.data[i], 12) != 0 ? 1 : 0;
     std::printf(
-        "%s at 1 s 160x120: %d streaks after the host's culling, %zu streak pixels (host splat) "
-        "and %zu (device splat); rgb PSNR device splat vs host splat %.2f dB, without the "
-        "particles %.2f dB (%lld pixels' radiance changed by them)\n",
-        file, list.num, host_pixels.size(), keyed, realtime_parity::Psnr(host.rgb, device.rgb),
-        realtime_parity::Psnr(host.rgb, bare.rgb), static_cast<long long>(changed));
-    EXPECT_GT(host_pixels.size(), 0u);
-    EXPECT_EQ(device.rgb.data, host.rgb.data);
-    EXPECT_EQ(device.radiance.data, host.radiance.data);
-    EXPECT_EQ(device.depth_m.data, host.depth_m.data);
-    EXPECT_EQ(device.ev100, host.ev100);
+        "%s at 1 s 160x120: %d streaks after the host's culling, %zu streak pixels; rgb PSNR "
+        "without the particles %.2f dB (%lld pixels' radiance changed by them)\n",
+        file, num, keyed, realtime_parity::Psnr(device.rgb, bare.rgb),
+        static_cast<long long>(changed));
+    EXPECT_GT(num, 0);
+    EXPECT_GT(keyed, 0u);
+    EXPECT_EQ(device.rgb.data, again.rgb.data);
     EXPECT_EQ(device.radiance.data, again.radiance.data);
+    EXPECT_EQ(device.depth_m.data, again.depth_m.data);
     EXPECT_GT(changed, 0);
-    EXPECT_NE(bare.radiance.data, device.radiance.data);
   }
 }
 
@@ -254,7 +241,6 @@ TEST(RealtimeHostPathEffectsFrames, LateStreaksGiveTheSameBits) {
     cuda::RealtimeFrameData& data = path.data();
     const cuda::BvhScene& bvh = path.bvh();
     ThreadPool& pool = path.pool();
-    ASSERT_TRUE(data.device_streaks());
     RenderedFrame late, none;
     const RenderedFrame serial = path.Render(view, fx.get());
     const int num = data.splat_streaks().View().num;
@@ -294,17 +280,14 @@ TEST(RealtimeHostPathEffectsFrames, LateStreaksGiveTheSameBits) {
 }
 
 // a moving camera with a rolling shutter (realtime_parity::AddRollingShutter) in the rain world
-// at 1 s, 160x120, through the device splat's functions (the default; here on the CPU): the
-// splat's rays are the CPU's Camera::GenerateRay to the bit (SplatRay over the rows' double
-// poses, StreakSplatView::rows), so the splat keys exactly the host splat's streak pixels (the
-// CPU's ParticleStreaks, each row at its own pose) with its t and coverage; the frame is the
-// host splat's byte for byte and matches the CPU backend's (rgb PSNR >= 40 dB, depth within 1 mm
-// on >= 99.9 % of pixels, the streak pixels' radiance within a tenth of their error without the
-// streaks). with the camera's float ray tables instead (PrimaryRay<true>) or the still camera's
-// rays the keys are not the host's (the check can fail). the splat's keys equal a brute force over
-// every pixel's ray and every streak (the boxes widened by the rows' motion, each row's columns in
-// its own pose); with the first row's pose only (StreakSplatView::poses null, as before) they
-// differ on most streak pixels.
+// at 1 s, 160x120, through the frame's splat (here on the CPU): the splat's rays are the CPU's
+// Camera::GenerateRay to the bit (SplatRay over the rows' double poses, StreakSplatView::rows),
+// and its keys equal a brute force over every pixel's ray and every streak (the boxes widened by
+// the rows' motion, each row's columns in its own pose); with the camera's float ray tables
+// instead (PrimaryRay<true>), the still camera's rays or the first row's pose only
+// (StreakSplatView::poses null) they differ (the check can fail). the frame matches the CPU
+// backend's (rgb PSNR >= 40 dB, depth within 1 mm on >= 99.9 % of pixels, the streak pixels'
+// radiance within a tenth of their error without the streaks).
 TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) {
   auto [session, snap, view, fx] = realtime_parity::LoadFrameAt("effects/rain.yaml", 1.0, 160, 120);
   const SceneDescription& scene = session->scene();
@@ -314,14 +297,8 @@ TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) 
   HostAndCpu rig(scene, snap);
   const HostCompared c = rig.Compare(view, fx.get());
   const RenderedFrame bare = rig.RenderWithoutParticles(view, *fx);
-  // the host splat of the same frame: its streak pixels and image
+  // the splat's keys with the frame's rays (the row table) and with the still camera's
   cuda::RealtimeFrameData& data = rig.data();
-  data.set_device_streaks(false);
-  const RenderedFrame host = rig.RenderHost(view, fx.get());
-  data.Prepare(snap, view, &rig.pool(), fx.get());
-  const std::vector<cuda::StreakPixel> host_pixels = data.streaks();
-  data.set_device_streaks(true);
-  // the device splat's keys with the frame's rays (the row table) and with the still camera's
   data.Prepare(snap, view, &rig.pool(), fx.get());
   const int W = view.intrinsics.width, H = view.intrinsics.height;
   cuda::RealtimeFrameView f = data.View(cuda::SceneView(), nullptr);
@@ -338,27 +315,9 @@ TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) 
     }
     return keys;
   };
-  // how many of the host splat's pixels keys misses or gives another t or coverage, and how
-  // many pixels it keys
-  const auto mismatch = [&](const std::vector<unsigned long long>& keys, size_t* keyed) {
-    *keyed = 0;
-    for (unsigned long long key : keys) *keyed += key != kNoStreakKey ? 1 : 0;
-    size_t bad = 0;
-    for (const cuda::StreakPixel& s : host_pixels) {
-      const unsigned long long key = keys[s.pixel];
-      const float t = key == kNoStreakKey ? 0.0f : StreakKeyT(key);
-      bad += key == kNoStreakKey || std::memcmp(&t, &s.t, sizeof(float)) != 0 ||
-                     list.streaks[StreakKeyIndex(key)].alpha != s.alpha
-                 ? 1
-                 : 0;
-    }
-    return bad;
-  };
-  size_t keyed = 0, keyed_float = 0, keyed_still = 0;
   ASSERT_NE(f.splat.rows, nullptr);
   ASSERT_NE(f.splat.poses, nullptr);
   const std::vector<unsigned long long> keys = splat_keys(f);
-  const size_t bad = mismatch(keys, &keyed);
   // every pixel's nearest streak by brute force (each pixel's ray, SplatRay, against every
   // streak): the splat's keys exactly; the splat with the first row's pose only (no
   // StreakSplatView::poses: its boxes and row columns of the first row's pose) misses some
@@ -390,36 +349,37 @@ TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) 
       "rain at 1 s 160x120, rolling shutter: brute force keys %zu pixels; the splat differs on "
       "%zu, with the first row's pose only on %zu\n",
       brute_keyed, brute_differ, first_differ);
+  // how many pixels' keys differ from the brute force's
+  const auto differ = [&](const std::vector<unsigned long long>& k) {
+    size_t n = 0;
+    for (size_t i = 0; i < brute.size(); ++i) n += brute[i] != k[i] ? 1 : 0;
+    return n;
+  };
+  EXPECT_GT(brute_keyed, 50u);
   EXPECT_EQ(brute_differ, 0u);
   EXPECT_GT(first_differ, brute_keyed / 4);
   // the frame's float ray tables instead of the double row poses (float rays), and
   // the still camera's rays
   cuda::RealtimeFrameView tables = f;
   tables.splat.rows = nullptr;
-  const size_t bad_float = mismatch(splat_keys(tables), &keyed_float);
+  const size_t bad_float = differ(splat_keys(tables));
   cuda::RealtimeFrameView still = tables;
   still.camera.rows = nullptr;
-  const size_t bad_still = mismatch(splat_keys(still), &keyed_still);
+  const size_t bad_still = differ(splat_keys(still));
+  const std::vector<cuda::StreakPixel> pixels = SplatPixels(data, W, H);
   double err = 0, bare_err = 0;
-  StreakPixelErrors(host_pixels, c, bare, &err, &bare_err);
+  StreakPixelErrors(pixels, c, bare, &err, &bare_err);
   std::printf(
-      "rain at 1 s 160x120, rolling shutter: %d streaks, %zu streak pixels (host splat), %zu keyed "
-      "by the splat (%zu not the host's), %zu with the float ray tables (%zu not the host's), %zu "
-      "with the still camera's rays (%zu not the host's); rgb PSNR against the CPU backend %.2f "
-      "dB (without the streaks %.2f dB), mean |radiance - cpu| on the streak pixels %.4g "
-      "(without %.4g) cd/m^2, depth > 1 mm on %.4f %%\n",
-      list.num, host_pixels.size(), keyed, bad, keyed_float, bad_float, keyed_still, bad_still,
-      c.psnr, realtime_parity::Psnr(c.cpu.rgb, bare.rgb),
-      err / std::max<size_t>(1, 3 * host_pixels.size()),
-      bare_err / std::max<size_t>(1, 3 * host_pixels.size()), 100 * c.depth_bad);
-  EXPECT_GT(host_pixels.size(), 50u);
-  EXPECT_EQ(keyed, host_pixels.size());
-  EXPECT_EQ(bad, 0u);
+      "rain at 1 s 160x120, rolling shutter: %d streaks, %zu streak pixels, %zu keys not the brute "
+      "force's with the float ray tables, %zu with the still camera's rays; rgb PSNR against the "
+      "CPU backend %.2f dB (without the streaks %.2f dB), mean |radiance - cpu| on the streak "
+      "pixels %.4g (without %.4g) cd/m^2, depth > 1 mm on %.4f %%\n",
+      list.num, pixels.size(), bad_float, bad_still, c.psnr,
+      realtime_parity::Psnr(c.cpu.rgb, bare.rgb), err / std::max<size_t>(1, 3 * pixels.size()),
+      bare_err / std::max<size_t>(1, 3 * pixels.size()), 100 * c.depth_bad);
+  EXPECT_EQ(pixels.size(), brute_keyed);
   EXPECT_GT(bad_float, 0u);
   EXPECT_GT(bad_still, 0u);
-  EXPECT_EQ(c.host.rgb.data, host.rgb.data);
-  EXPECT_EQ(c.host.radiance.data, host.radiance.data);
-  EXPECT_EQ(c.host.depth_m.data, host.depth_m.data);
   EXPECT_EQ(c.host.rgb.data, c.again.rgb.data);
   EXPECT_GE(c.psnr, 40.0);
   EXPECT_LE(c.depth_bad, 0.001);

@@ -10,12 +10,11 @@
 //     (CUDA events, no copies);
 //   - cpu depth+seg and cpu rgb+depth (realtime tier), all cores;
 //   - for a world with effects at 1 s (e.g. worlds/effects/flashlight.yaml), rgb+depth under
-//     them, cuda Render() and cpu Render(); with particles also cuda Render() with the streaks
-//     splatted on the host (RealtimeFrameData::set_device_streaks(false)), the host's
-//     preparation of each, the drops culled on the device with late streaks twice (the host's
-//     time making the streaks), where one rain frame's time goes, a rolling-shutter camera
-//     turning during the readout (realtime_parity::AddRollingShutter) with the device splat and
-//     the host splat and the pixels each keys, and the FNV-1a hashes of the rgb, depth and
+//     them, cuda Render() and cpu Render(); with particles also the host's preparation, the
+//     drops culled on the device with late streaks twice (the host's time making the streaks),
+//     where one rain frame's time goes, a rolling-shutter camera turning during the readout
+//     (realtime_parity::AddRollingShutter) and the pixels the splat keys, and the FNV-1a hashes
+//     of the rgb, depth and
 //     radiance and the EV100 of a frame;
 //     with media
 //     (homogeneous or grids), the time of their
@@ -33,14 +32,12 @@
 // time); then the device-to-host copy rates, pinned and pageable.
 // --media [--size WxH]: for each world's effects frame with media (first camera at 1 s, WxH,
 // default 640x480), Render() of rgb+depth with the media volumes (the world light volume and fog
-// froxels, the grids' light volumes and froxels) built by the
-// device's kernels (the default) and on the host
-// (RealtimeFrameData::set_device_media(false), as before), interleaved three times: frames/s,
+// froxels, the grids' light volumes and froxels) built by the device's kernels, three times:
+// frames/s,
 // the host's preparation (CudaRenderer::last_prepare_ms), RealtimeMedia::Build's host time and
 // its stages (RealtimeMedia::BuildTimes), the device's first stage by CUDA events (the media's
 // uploads, with device-built volumes their kernels, and the geometry kernel:
-// RealtimeStageTimes::geometry); whether two device-built renders give the same bits
-// and the rgb PSNR of the device-built frame against the host-built one; then, as in a run, a
+// RealtimeStageTimes::geometry); whether two renders give the same bits; then, as in a run, a
 // new frame every 1/30 s of sim time after the first (the session stepped on, each frame's
 // snapshot and effects evaluated before the timing), so the grids' densities and emission are
 // new arrays every frame and go to the device every frame: the same columns and the bytes
@@ -231,34 +228,15 @@ int MediaMain(const std::vector<std::string>& worlds, int width, int height, int
     gpu_settings.backend = RenderSettings::Backend::kCuda;
     const std::unique_ptr<Renderer> gpu = MakeRenderer(scene, gpu_settings);
     auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
-    RenderedFrame dev_a, dev_b, host_f;
+    RenderedFrame dev_a, dev_b;
     gpu->Render(snap, fx.get(), view, &dev_a);
     cuda::RealtimeFrameData& data = g->realtime_frame();
     gpu->Render(snap, fx.get(), view, &dev_b);
-    data.set_device_media(false);
-    gpu->Render(snap, fx.get(), view, &host_f);
     const bool repeat = dev_a.rgb.data == dev_b.rgb.data &&
                         dev_a.radiance.data == dev_b.radiance.data &&
                         dev_a.depth_m.data == dev_b.depth_m.data;
-    double se = 0;
-    for (size_t i = 0; i < dev_a.rgb.data.size(); ++i) {
-      const double e = static_cast<double>(dev_a.rgb.data[i]) - host_f.rgb.data[i];
-      se += e * e;
-    }
-    const double mse = se / std::max<size_t>(1, dev_a.rgb.data.size());
-    notes.push_back(fmt::format(
-        "{} {}: device-built volumes: two renders bit-identical (rgb, radiance, depth): {}; rgb "
-        "PSNR against the host-built frame {} ({} of {} bytes differ)",
-        world.name, size, repeat ? "yes" : "NO",
-        mse == 0 ? std::string("inf (equal)")
-                 : fmt::format("{:.2f} dB", 10 * std::log10(255.0 * 255.0 / mse)),
-        [&] {
-          size_t k = 0;
-          for (size_t i = 0; i < dev_a.rgb.data.size(); ++i)
-            k += dev_a.rgb.data[i] != host_f.rgb.data[i];
-          return k;
-        }(),
-        dev_a.rgb.data.size()));
+    notes.push_back(fmt::format("{} {}: two renders bit-identical (rgb, radiance, depth): {}",
+                                world.name, size, repeat ? "yes" : "NO"));
     // one row: `frames` frames rendered by render_frame(i) after 3 untimed ones (i = -1), with
     // the host's preparation, the media build and its stages and the device's first stage
     auto timed_row = [&](const std::string& label, auto render_frame) {
@@ -284,14 +262,8 @@ int MediaMain(const std::vector<std::string>& worlds, int width, int height, int
           st.fog_froxels / frames, geometry / frames);
     };
     RenderedFrame f;
-    for (int round = 0; round < 3; ++round) {
-      for (const bool device : {false, true}) {
-        data.set_device_media(device);
-        timed_row(device ? "device (the volumes as kernels)" : "host (as before)",
-                  [&](int) { gpu->Render(snap, fx.get(), view, &f); });
-      }
-    }
-    data.set_device_media(true);
+    for (int round = 0; round < 3; ++round)
+      timed_row("the volumes as kernels", [&](int) { gpu->Render(snap, fx.get(), view, &f); });
     // as in a run: a new snapshot and effects frame every 1/30 s of sim time (new grid arrays
     // every frame, uploaded every frame), evaluated before the timing.
     Simulation& sim = world.session->sim();
@@ -863,20 +835,11 @@ int Main(int argc, char** argv) {
         rows.push_back({name, size, fx_outputs, "cuda", "Render()",
                         1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
         if (!fx->particles.empty()) {
-          // the particle streaks splatted on the device (the default) against the
-          // host splat of before (RealtimeFrameData::set_device_streaks(false)), then the device
-          // again (drift)
+          // the particle streaks splatted on the device
           auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
           const double prep_device = g->last_prepare_ms();
           const double late_ms = g->last_late_streaks_ms();
           const int streaks = g->realtime_frame().splat_streaks().View().num;
-          g->realtime_frame().set_device_streaks(false);
-          const double host_fps = 1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get());
-          const double prep_host = g->last_prepare_ms();
-          const size_t host_pixels = g->realtime_frame().streaks().size();
-          g->realtime_frame().set_device_streaks(true);
-          rows.push_back({name, size, "rgb+depth realtime + effects, streaks splatted on the host",
-                          "cuda", "Render()", host_fps});
           // the drops culled on the device (late streaks), two rounds: the host's time making
           // the streaks (last_late_streaks_ms) and DeviceStreakCull's
           double cull_device_ms[2] = {0, 0}, cull_run_ms[2] = {0, 0}, cull_stage_ms[2] = {0, 0};
@@ -935,7 +898,7 @@ int Main(int argc, char** argv) {
           }
           // a rolling-shutter camera that turns 0.25 rad and moves 16 cm during its 30 ms
           // readout (realtime_parity::AddRollingShutter): the device splat, whose boxes and row
-          // columns follow the rows' poses, and the host splat
+          // columns follow the rows' poses
           CameraView rolling = rgb;
           realtime_parity::AddRollingShutter(&rolling);
           rows.push_back({name, size,
@@ -948,27 +911,17 @@ int Main(int argc, char** argv) {
           const double rolling_prep = g->last_prepare_ms(),
                        rolling_late = g->last_late_streaks_ms();
           const int rolling_streaks = g->realtime_frame().splat_streaks().View().num;
-          g->realtime_frame().set_device_streaks(false);
-          rows.push_back({name, size,
-                          "rgb+depth realtime + effects, rolling shutter turning, streaks "
-                          "splatted on the host",
-                          "cuda", "Render()",
-                          1 / TimeRenders(gpu.get(), snap, rolling, n, fx.get())});
-          const size_t rolling_host = g->realtime_frame().streaks().size();
-          g->realtime_frame().set_device_streaks(true);
           builds.push_back(fmt::format(
-              "{} {}: rolling shutter turning: {} streaks, {} pixels keyed by the device splat, "
-              "{} streak pixels of the host splat; host preparation {:.2f} ms a frame, {:.2f} ms "
-              "making the streaks while the GPU works (device splat)",
-              name, size, rolling_streaks, rolling_keyed, rolling_host, rolling_prep,
-              rolling_late));
+              "{} {}: rolling shutter turning: {} streaks, {} pixels keyed by the device splat; "
+              "host preparation {:.2f} ms a frame, {:.2f} ms making the streaks while the GPU "
+              "works",
+              name, size, rolling_streaks, rolling_keyed, rolling_prep, rolling_late));
           builds.push_back(fmt::format(
-              "{} {}: particles: {} streaks after the host's culling, {} streak pixels; host "
-              "preparation {:.2f} ms a frame with the device splat (late streaks: before the "
-              "kernels, and {:.2f} ms making the streaks while the GPU works), {:.2f} ms with the "
-              "host splat (CudaRenderer::last_prepare_ms and last_late_streaks_ms of the last "
+              "{} {}: particles: {} streaks after the host's culling; host preparation {:.2f} ms "
+              "a frame (late streaks: before the kernels, and {:.2f} ms making the streaks while "
+              "the GPU works; CudaRenderer::last_prepare_ms and last_late_streaks_ms of the last "
               "timed frame)",
-              name, size, streaks, host_pixels, prep_device, late_ms, prep_host));
+              name, size, streaks, prep_device, late_ms));
           // every output of a frame, to compare builds
           RenderedFrame late_frame;
           gpu->Render(snap, fx.get(), rgb, &late_frame);

@@ -147,8 +147,7 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
   // media volumes' shadow rays on the GPU, over the BVH Render posed
   if (!media_query_) media_query_ = std::make_unique<CudaRayQuery>(*bvh_, device_.get());
   // late streaks: the drops culled while the GPU traces and shades
-  const bool late = realtime_->device_streaks() && effects != nullptr && !effects->empty() &&
-                    !effects->particles.empty();
+  const bool late = effects != nullptr && !effects->empty() && !effects->particles.empty();
   late_streaks_ms_ = late_streaks_start_ms_ = 0;
   cull_queued_ = false;
   realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_, media_query_.get(),

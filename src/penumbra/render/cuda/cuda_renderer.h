@@ -11,8 +11,7 @@
 // tiers renders on the GPU (the host prepares each frame and, in the pathtraced tier, denoises
 // and develops it); docs/gpu.md lists what is where.
 //
-// a realtime frame with particles whose streaks the frame splats itself
-// (RealtimeFrameData::device_streaks) makes its streaks late: Render prepares the frame without
+// a realtime frame with particles makes its streaks late: Render prepares the frame without
 // them (RealtimeFrameData::Prepare's `streaks` false), queues the device's work up to the
 // shading, and makes the streaks (RealtimeFrameData::PrepareStreaks) while the GPU traces and
 // shades (DeviceRealtime::Render's `streaks`); their drops are culled on the device
@@ -77,8 +76,7 @@ class CudaRenderer final : public Renderer {
   /// the realtime rgb path's device side (after a first rgb frame on the GPU), for benchmarks.
   DeviceRealtime& device_realtime() { return *device_realtime_; }
   /// the realtime rgb path's host side (after a first rgb frame on the GPU), for benchmarks:
-  /// where its media volumes are built (RealtimeFrameData::set_device_media) and how long the
-  /// host's part took (media_build_ms, media_build_times).
+  /// how long the host's part of the media took (media_build_ms, media_build_times).
   RealtimeFrameData& realtime_frame() { return *realtime_; }
   /// the pathtraced tier's device side (after a first pathtraced frame on the GPU), for
   /// benchmarks.

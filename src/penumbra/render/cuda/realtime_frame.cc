@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <string>
 
 #include "penumbra/core/error.h"
@@ -154,7 +153,6 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
 
 void RealtimeFrameData::ClearStreaks() {
   streaks_culled_ = 0;
-  streaks_.clear();
   path_streaks_.Clear();
   splat_streaks_.Clear();
   device_list_ = DeviceStreakList();
@@ -181,7 +179,7 @@ void RealtimeFrameData::PrepareMedia(const WorldSnapshot& snapshot, const Effect
   realtime_media_.Build(
       media_, lights_, *media_rays, camera, FrameKey(view.camera_index, view.frame_index),
       scene_.center_W.cast<float>(), scene_.extent_m, SkyAmbientRadiance(*frame_sky_),
-      volume_.empty() ? nullptr : &volume_, pool, device_media_);
+      volume_.empty() ? nullptr : &volume_, pool, /*device_volumes=*/true);
   media_view_ = realtime_media_.HostView(&media_arrays_);
   media_build_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -205,9 +203,9 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   }
   const bool realtime = settings_.tier == RenderSettings::Tier::kRealtime;
   // as the CPU's MediaFrame::Prepare: the sheltered drops left out, the rain streaks the
-  // frame's homogeneous media hide culled, the streaks splatted per pixel (on the host, or by
-  // the frame itself: device_streaks), the rain shaded once per streak (device_streaks: per
-  // pixel by the frame)
+  // frame's homogeneous media hide culled; under the realtime tier the frame itself splats the
+  // streaks and shades them per pixel, under the pathtraced tier every rain streak is shaded
+  // once
   bool sheltered = false;
   for (const ParticleSet& ps : fx->particles) sheltered = sheltered || ShelterApplies(ps);
   shelter_update_ms_ = 0;
@@ -219,10 +217,9 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   }
   if (!fx->homogeneous_media.empty() || !fx->grid_media.empty()) BuildMediaScene(fx);
   const MediaScene* media = media_scene_built_ && !media_.empty() ? &media_ : nullptr;
-  const bool device_splat = realtime && device_streaks_;
   // the device's drop culling (device_drop_culler_): the host prepares its inputs only
-  const bool device_cull = device_splat && has_drop_culler();
-  particles_.set_host_splat(!device_splat);
+  const bool device_cull = realtime && has_drop_culler();
+  particles_.set_host_splat(!realtime);
   particles_.set_host_culling(!device_cull);
   particles_.Build(fx, camera, view.exposure_time_sec,
                    realtime ? StreakRays::kPixelCentres : StreakRays::kCamera, pool, media,
@@ -239,47 +236,16 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   }
   if (particles_.empty()) return;
   const Eigen::Vector3f sky_ambient = SkyAmbientRadiance(*frame_sky_);
-  if (device_splat) {
+  if (realtime) {
     // the streaks in index order and the camera's projection for the frame's splat
     // (StreakSplatView)
     splat_streaks_.BuildList(particles_, sky_ambient);
     SetSplatCamera(camera);
     return;
   }
+  // the pathtraced tier: the paths trace the streaks themselves (path_streaks.h)
   particles_.PrecomputeRain(lights_, sky_ambient, volume_.empty() ? nullptr : &volume_, pool);
-  if (!realtime) {
-    // the pathtraced tier: the paths trace the streaks themselves (path_streaks.h)
-    path_streaks_.Build(particles_, sky_ambient, pool);
-    return;
-  }
-  // every pixel's nearest streak, shaded as RealtimeIntegrator's view effects shade it (for
-  // the CPU's pixel ray: the streak's t does not depend on the surface behind it, which the
-  // kernel compares), row by row, concatenated in row order
-  const int W = camera.width(), H = camera.height();
-  streak_rows_.resize(H);
-  const float inf = std::numeric_limits<float>::infinity();
-  ParallelForOrSerial(pool, H, [&](int64_t v) {
-    std::vector<StreakPixel>& row = streak_rows_[v];
-    row.clear();
-    for (int u = 0; u < W; ++u) {
-      if (!particles_.PixelHasStreak(u, static_cast<int>(v))) continue;
-      const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
-      ParticleHit ph;
-      if (!particles_.PixelHit(ray, u, static_cast<int>(v), inf, &ph)) continue;
-      const float d_len = ray.d.norm();
-      const Eigen::Vector3f d = ray.d / d_len;
-      const Eigen::Vector3f Lp =
-          particles_.Shade(ph, ray.o + (ph.t * d_len) * d, lights_, sky_ambient);
-      StreakPixel s;
-      s.pixel = v * W + u;
-      s.t = ph.t;
-      s.alpha = ph.alpha;
-      s.L = Float3{Lp.x(), Lp.y(), Lp.z()};
-      row.push_back(s);
-    }
-  });
-  for (const std::vector<StreakPixel>& row : streak_rows_)
-    streaks_.insert(streaks_.end(), row.begin(), row.end());
+  path_streaks_.Build(particles_, sky_ambient, pool);
 }
 
 void RealtimeFrameData::SetSplatCamera(const Camera& camera) {
@@ -456,8 +422,8 @@ const PathStreakBuild& RealtimeFrameData::splat_streaks() const {
 }
 
 void RealtimeFrameData::StreakFields(RealtimeFrameView* f) const {
-  f->streaks = streaks_.empty() ? nullptr : streaks_.data();
-  f->num_streaks = static_cast<int64_t>(streaks_.size());
+  f->streaks = nullptr;
+  f->num_streaks = 0;
   f->splat = StreakSplatView();
   if (device_list_.bound > 0) {
     // the device culling's streaks in place: a bound here, their count on the device
@@ -552,13 +518,11 @@ struct HostShadowPush {
 
 namespace {
 
-// the shared visibility of frame f by shadow tiles, as the kernels' blocks with
-// RealtimeKernelOptions::tile_penumbra and tile_visibility (VisibilityRaysWarpKernel,
-// VisibilityTileKernel) do it in shared memory: per tile, its surfaces and every light's
-// verdicts as bit rows copied for the penumbra rays (RealtimeKernelOptions::staged_window and
-// window_verdict_rows: TileWindowSurfaces, RowLightVerdicts, SharedVisibilityRaysOf), then light
-// after light its verdicts, ray counts (packed once, ShadowWindowCounts, as
-// RealtimeKernelOptions::packed_window_counts packs them) and fractions (SharedWindowFraction)
+// the shared visibility of frame f by shadow tiles, as the kernels' blocks
+// (VisibilityRaysWarpKernel, VisibilityTileKernel) do it in shared memory: per tile, its
+// surfaces and every light's verdicts as bit rows copied for the penumbra rays
+// (TileWindowSurfaces, RowLightVerdicts, SharedVisibilityRaysOf), then light after light its
+// verdicts, ray counts (packed once, ShadowWindowCounts) and fractions (SharedWindowFraction)
 // for the resolve (SharedLampFraction, AddSharedVisibility).
 void TiledSharedVisibility(const RealtimeFrameView& f, ThreadPool* pool, Float3* radiance) {
   const int W = f.camera.width, H = f.camera.height;
@@ -574,8 +538,7 @@ void TiledSharedVisibility(const RealtimeFrameView& f, ThreadPool* pool, Float3*
   };
   ParallelForOrSerial(pool, int64_t{tiles_x} * tiles_y, [&](int64_t tile) {
     // the tile's surfaces (TileWindowSurfaces) and every light's verdicts as bit rows
-    // (ShadowVerdictBits), as RealtimeKernelOptions::staged_window and window_verdict_rows
-    // keep them
+    // (ShadowVerdictBits), as the kernels' shared memory keeps them
     std::vector<uint32_t> rows(static_cast<size_t>(kShadowVerdictRows) * std::max(f.num_lights, 1));
     int32_t key[kTile];
     float ng[3][kTile], p[3][kTile];
@@ -805,11 +768,8 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
         MediaViewQuad(f, u0, 2 * static_cast<int>(q), out->depth_m.data.data(), radiance.data());
     });
   }
-  // the particle streaks over the final radiance, as StreakKernel (with media: MediaViewQuad)
-  for (int64_t k = 0; f.has_media == 0 && k < f.num_streaks; ++k) {
-    const StreakPixel& s = f.streaks[k];
-    radiance[s.pixel] = ApplyStreak(s, out->depth_m.data[s.pixel], radiance[s.pixel]);
-  }
+  // the particle streaks over the final radiance, as StreakSplatApplyKernel (with media:
+  // MediaViewQuad)
   for (int64_t i = 0; f.has_media == 0 && f.splat.streaks.num > 0 && i < n; ++i) {
     StreakPixel s;
     if (PixelStreakOf(f, i, &s)) radiance[i] = ApplyStreak(s, out->depth_m.data[i], radiance[i]);

@@ -6,9 +6,8 @@
 // LightSampler::Update, the moved or scaled sky and the surface wetness through
 // render/effects_sky.h, as the CPU backend's MediaFrame), particles (rain, snow, sparks: the
 // drops culled on the host with the CPU's render/particle_streaks.h, the streaks then splatted,
-// shaded and drawn over each pixel by the frame itself, StreakSplatView; or, without
-// device_streaks, each pixel's nearest streak found and shaded on the host, StreakPixel) and
-// media (homogeneous and grids:
+// shaded and drawn over each pixel by the frame itself, StreakSplatView) and media
+// (homogeneous and grids:
 // PrepareMedia, RealtimeMedia's layouts built on the host and its four volumes (the grids' light
 // volumes and froxels, the world light volume, the fog froxels) by the frame itself on the
 // device; the kernels' view pass draws them and
@@ -70,7 +69,7 @@ class RealtimeFrameData {
   /// shadow rays (see there). `streaks` false: PrepareStreaks is left out and the frame has no
   /// streaks (those of an earlier frame are dropped) until the caller calls it, after PrepareMedia
   /// (the same streaks: PrepareStreaks reads nothing PrepareMedia writes); CudaRenderer does so
-  /// while the GPU shades (CudaRenderer::set_late_streaks).
+  /// while the GPU shades (CudaRenderer's late streaks).
   /// @throws ConfigError for effects out of range (a negative light or sky scale, a wetness
   /// outside [0, 1]), as the CPU backend; with `streaks`, as PrepareStreaks.
   void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool,
@@ -79,15 +78,14 @@ class RealtimeFrameData {
   /// the media of the frame (View's media, has_media): with homogeneous or grid media in
   /// `effects` (null or none: no media), the CPU backend's RealtimeMedia (render/
   /// media_realtime.h) built as its MediaFrame builds it, for `camera` and the frame key of
-  /// `view`, with the frame's lights, sky and occluded sky volume: without device_media the
-  /// shadow rays of the grids' light volumes and of the world light volume through `media_rays`
-  /// (any RayQuery posed for `snapshot`: CudaRenderer passes one over its device scene), or, if
-  /// null, through a BvhRayQuery (the kernels' traversal on the host) this object keeps and
-  /// poses; RealtimeMedia::HostView's arrays for the view (the grids' froxels and light volumes
-  /// too). with device_media (the default) the grids' light volumes and froxels, the world light
-  /// volume's cells and the fog froxels are left to the frame (View's media_build: the device's
+  /// `view`, with the frame's lights, sky and occluded sky volume; RealtimeMedia::HostView's
+  /// arrays for the view. the grids' light volumes and froxels, the world light volume's cells
+  /// and the fog froxels are left to the frame (View's media_build: the device's
   /// MediaGridLightKernel, MediaGridFroxelKernel, MediaLightVolumeKernel and MediaFogSliceKernel,
-  /// or BuildMediaVolumesOnHost), with the grids' arrays. call after PoseWorld (Prepare does).
+  /// or BuildMediaVolumesOnHost), with the grids' arrays. `media_rays`: the shadow rays of the
+  /// layouts' host part (any RayQuery posed for `snapshot`: CudaRenderer passes one over its
+  /// device scene), or, if null, a BvhRayQuery (the kernels' traversal on the host) this object
+  /// keeps and poses. call after PoseWorld (Prepare does).
   void PrepareMedia(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                     const Camera& camera, const CameraView& view, ThreadPool* pool,
                     const RayQuery* media_rays = nullptr);
@@ -104,12 +102,6 @@ class RealtimeFrameData {
   const RealtimeMedia::BuildTimes& media_build_times() const {
     return realtime_media_.build_times();
   }
-  /// whether PrepareMedia leaves the media volumes (the grids' light volumes and froxels, the
-  /// world light volume's cells, the fog froxels) to the frame (View's media_build: the
-  /// device's kernels, or BuildMediaVolumesOnHost; default true) or builds them on the host with
-  /// the rest of RealtimeMedia (false).
-  void set_device_media(bool on) { device_media_ = on; }
-  bool device_media() const { return device_media_; }
   /// the camera-independent part of Prepare: the lights, the geoms (their transforms made
   /// again only for bodies whose pose changed since the last call), the effects' sky and
   /// wetness and the sky volume. @throws as Prepare.
@@ -125,31 +117,17 @@ class RealtimeFrameData {
   /// (null or none: no streaks), the CPU backend's ParticleStreaks of `camera` (render/
   /// particle_streaks.h: the drops a ShelterMap shelters left out, rain the frame's homogeneous
   /// media hide culled; with a device drop culler, set_device_drop_culler, the culler decides the
-  /// drops); with
-  /// device_streaks (the default) the streaks in index order and the
-  /// camera's projection for the frame's own splat (splat_streaks(), View's splat); else
-  /// splatted per pixel over `pool`, rain shaded once per
-  /// streak, then each pixel's nearest streak shaded by ParticleStreaks::Shade as
-  /// RealtimeIntegrator does (the frame's lights and sky, the occluded sky volume), in pixel
-  /// order; the media in front of a streak are applied in the view pass (MediaViewQuad). call
-  /// after PoseWorld (Prepare does). under the pathtraced tier's settings instead, as the CPU's
-  /// MediaFrame::Prepare for that tier: the streaks without the per-pixel splat and culling,
-  /// every rain streak shaded once, and their BVH for the paths (path_streaks(); no streak
-  /// pixels).
+  /// drops); the streaks in index order and the camera's projection for the frame's own splat
+  /// (splat_streaks(), View's splat: the device's splat kernels, or RenderRealtimeOnHost, find
+  /// and shade each pixel's nearest streak); the media in front of a streak are applied in the
+  /// view pass (MediaViewQuad). call after PoseWorld (Prepare does). under the pathtraced tier's
+  /// settings instead, as the CPU's MediaFrame::Prepare for that tier: the streaks without the
+  /// per-pixel splat and culling, every rain streak shaded once, and their BVH for the paths
+  /// (path_streaks(); no streak pixels).
   /// @throws ConfigError for malformed particle sets (ParticleStreaks::Build).
   void PrepareStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                       const Camera& camera, const CameraView& view, ThreadPool* pool);
-  /// the streak pixels of the last PrepareStreaks (the host splat; empty with device_streaks).
-  const std::vector<StreakPixel>& streaks() const { return streaks_; }
-  /// whether the realtime tier's streaks are splatted and shaded per pixel by the frame itself
-  /// (default true: PrepareStreaks culls the drops on the host, then
-  /// hands the streaks in index order to View's `splat`, StreakSplatView: the device's splat
-  /// kernels, or RenderRealtimeOnHost) or found and shaded on the host (false: the CPU's
-  /// ParticleStreaks splat, PrecomputeRain and Shade, View's `streaks`; benchmarks
-  /// and tests compare the two).
-  void set_device_streaks(bool on) { device_streaks_ = on; }
-  bool device_streaks() const { return device_streaks_; }
-  /// the streaks the frame splats itself (device_streaks; empty without particles or under the
+  /// the streaks the frame splats itself (empty without particles or under the
   /// pathtraced tier's settings): PathStreakBuild::View as View's splat.streaks. with a device
   /// drop culler (set_device_drop_culler) the streaks stay on the device for the frame's splat;
   /// this call copies them to the host (DeviceStreakList::download: it waits for the culling)
@@ -174,15 +152,14 @@ class RealtimeFrameData {
     std::function<void(std::vector<StreakPod>* out)> download;
   };
   /// the drops' culling on the device, without the host's wait
-  /// (CudaRenderer::set_device_culling sets it): with device_streaks under the realtime tier's
-  /// settings, PrepareStreaks has ParticleStreaks prepare the decision's inputs only
-  /// (set_host_culling(false): the sets' lengths checked, no drop decided) and calls it with the
-  /// frame's effects and those inputs; it queues its work (the drawn streaks in index order,
-  /// StreakPod, prim = the index, as ParticleStreaks::Build makes them) and returns where its
-  /// streaks will be (DeviceStreakList); the culled rain and any non-finite drop are known once
-  /// the frame's device work is done: the caller then reports the culled rain
-  /// (FinishDeviceCulling) or throws the culler's ConfigError. empty (the default): the host
-  /// decides the drops.
+  /// (CudaRenderer sets it): under the realtime tier's settings, PrepareStreaks has ParticleStreaks
+  /// prepare the decision's inputs only (set_host_culling(false): the sets' lengths checked, no
+  /// drop decided) and calls it with the frame's effects and those inputs; it queues its work (the
+  /// drawn streaks in index order, StreakPod, prim = the index, as ParticleStreaks::Build makes
+  /// them) and returns where its streaks will be (DeviceStreakList); the culled rain and any
+  /// non-finite drop are known once the frame's device work is done: the caller then reports the
+  /// culled rain (FinishDeviceCulling) or throws the culler's ConfigError. empty (the default): the
+  /// host decides the drops.
   using DeviceDropCuller =
       std::function<DeviceStreakList(const EffectsFrame& fx, const StreakCullSetup& setup)>;
   void set_device_drop_culler(DeviceDropCuller culler) { device_drop_culler_ = std::move(culler); }
@@ -238,12 +215,11 @@ class RealtimeFrameData {
 
   /// the frame's view with host pointers (scene: the traversal's arrays; sky: per pixel).
   RealtimeFrameView View(const SceneView& scene, const Float3* sky) const;
-  /// sets the particle streak fields of *f (streaks and num_streaks: the host splat's pixels;
-  /// splat: the device splat's streaks, host arrays, or with a device drop culler its device
-  /// array, a bound and the device count, and the camera's projection) to those of the
-  /// last PrepareStreaks (none after a Prepare without streaks), as View sets them: the late
-  /// streaks that CudaRenderer hands to DeviceRealtime::Render's `streaks`. the arrays stay
-  /// valid until the next Prepare or PrepareStreaks.
+  /// sets the particle streak fields of *f (splat: the frame's splat's streaks, host arrays, or
+  /// with a device drop culler its device array, a bound and the device count, and the camera's
+  /// projection) to those of the last PrepareStreaks (none after a Prepare without streaks), as
+  /// View sets them: the late streaks that CudaRenderer hands to DeviceRealtime::Render's
+  /// `streaks`. the arrays stay valid until the next Prepare or PrepareStreaks.
   void StreakFields(RealtimeFrameView* f) const;
 
   /// the EV100 of a frame whose rows' log-luminance sums are `row_sums` (film.h's auto
@@ -276,13 +252,10 @@ class RealtimeFrameData {
   const SkyModel* frame_sky_ = &sky_;  // the frame's: sky_ or effects_sky_'s
   float wetness_ = 0;                  // EffectsFrame::surface_wetness of the frame
   SkyIrradianceVolume volume_;
-  ShelterMap shelter_;         // where rain and snow do not fall (PrepareStreaks)
-  ParticleStreaks particles_;  // the frame's streaks (PrepareStreaks)
-  std::vector<StreakPixel> streaks_;
+  ShelterMap shelter_;            // where rain and snow do not fall (PrepareStreaks)
+  ParticleStreaks particles_;     // the frame's streaks (PrepareStreaks)
   PathStreakBuild path_streaks_;  // the pathtraced tier's streaks and BVH (PrepareStreaks)
-  std::vector<std::vector<StreakPixel>> streak_rows_;  // per row, then concatenated
-  bool device_streaks_ = true;
-  // the realtime streaks in index order (device_streaks); with a device drop culler only the
+  // the realtime streaks in index order; with a device drop culler only the
   // sets, and the streaks once splat_streaks downloads them (device_pods_copied_)
   mutable PathStreakBuild splat_streaks_;
   StreakSplatView splat_camera_;             // their projection (R_OW, p_OW, intrinsics; rows)
@@ -306,7 +279,6 @@ class RealtimeFrameData {
   void BuildMediaScene(const EffectsFrame* fx);
   RealtimeMediaView media_view_;
   bool media_ready_ = false;
-  bool device_media_ = true;
   double media_build_ms_ = 0;
   double volume_update_ms_ = 0;
   double shelter_update_ms_ = 0;
@@ -356,16 +328,15 @@ void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolume
 /// (ShadeRealtimeStored, the kernels' default) instead of evaluating the surface again
 /// (ShadeRealtimePixel); the two give the same bits. `strided_terms` (with stored_surface):
 /// the lights' terms wait between ShadeRealtimePoint's loops in a row's array interleaved over
-/// its pixels (StridedLightTerms, as the kernels' shared memory with
-/// RealtimeKernelOptions::shared_light_terms) instead of each pixel's own (LocalLightTerms);
-/// the same bits. `queued_shadows` (with stored_surface, at most kMaxQueuedShadowLights
-/// lights): the shadow rays apart in three passes as RealtimeKernelOptions::queue_shadow_rays
-/// (ShadeQueuedStored, each ray traced from QueuedRay, SumQueuedLights; the lights' terms in
-/// each pixel's own arrays); the same bits. `tiled_visibility`: the shared visibility by 16x16
-/// shadow tiles, each tile's verdicts, ray counts and fractions copied into tile arrays where
-/// the windows find their neighbours, as the kernels' blocks do in shared memory with
-/// RealtimeKernelOptions::tile_penumbra and tile_visibility (SharedVisibilityRays' tile form,
-/// SharedWindowFraction, SharedLampFraction); the same bits.
+/// its pixels (StridedLightTerms, as the shading kernel's shared memory) instead of each pixel's
+/// own (LocalLightTerms); the same bits. `queued_shadows` (with stored_surface, at most
+/// kMaxQueuedShadowLights lights): the shadow rays apart in three passes as the kernels'
+/// queued shadow rays (ShadeQueuedStored, each ray traced from QueuedRay, SumQueuedLights; the
+/// lights' terms in each pixel's own arrays); the same bits. `tiled_visibility`: the shared
+/// visibility by 16x16 shadow tiles, each tile's verdicts, ray counts and fractions copied into
+/// tile arrays where the windows find their neighbours, as the kernels' blocks do in shared
+/// memory (SharedVisibilityRays' tile form, SharedWindowFraction, SharedLampFraction); the same
+/// bits.
 void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
                           RenderedFrame* out, bool stored_surface = false,
                           bool strided_terms = false, bool queued_shadows = false,

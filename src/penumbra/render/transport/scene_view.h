@@ -82,10 +82,8 @@ struct PixelGeometry {
 };
 
 /// a pixel's nearest particle streak (EffectsFrame::particles), shaded: drawn over the pixel's
-/// radiance where it lies in front of the primary hit (ApplyStreak). made by the device's splat
-/// (StreakSplatView: SplatStreakRow, ShadeSplatPixel) or, with the host splat
-/// (RealtimeFrameData::set_device_streaks(false)), found and shaded on the host by the CPU
-/// backend's functions (ParticleStreaks::PixelHit and Shade, render/particle_streaks.h).
+/// radiance where it lies in front of the primary hit (ApplyStreak). made by the frame's splat
+/// (StreakSplatView: SplatStreakRow, ShadeSplatPixel).
 struct StreakPixel {
   int64_t pixel = 0;  ///< row-major pixel index
   float t = 0;        ///< ray parameter of the streak (the primary ray's units: as the depth)
@@ -185,9 +183,8 @@ struct RealtimeFrameView {
   TraceHit* mirror_hits = nullptr;
   const Float3* mirror_sky = nullptr;
   Float3* mirror_radiance = nullptr;
-  /// the frame's particle streaks found and shaded on the host (the host splat,
-  /// RealtimeFrameData::set_device_streaks(false)), num_streaks of them in pixel order (none:
-  /// no particles, or the device splat's `splat`).
+  /// streak pixels shaded before the frame, num_streaks of them in pixel order, drawn by the
+  /// view pass (RealtimeFrameData gives none: the frame splats its streaks itself, `splat`).
   const StreakPixel* streaks = nullptr;
   int64_t num_streaks = 0;
   /// the frame's particle streaks for the splat the frame makes itself (streaks.num 0: none).
