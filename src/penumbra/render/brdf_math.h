@@ -1,9 +1,9 @@
 #pragma once
 // the realtime tier's BRDF arithmetic, shared by the CPU lanes (render/cpu/bsdf_lanes.h) and the
-// CUDA kernels (render/cuda/realtime_kernels.cu): the glTF 2.0 metallic-roughness BRDF of
-// bsdf.h evaluated in the world frame, and the split-sum ambient specular fit. templates over
-// the scalar type T (float or Lanes) and a 3-vector type V with members x, y, z of type T
-// (render/shading_math.h).
+// CUDA kernels (render/transport/surface.h, run by render/cuda/realtime_*.cu): the glTF 2.0
+// metallic-roughness BRDF of bsdf.h evaluated in the world frame, and the split-sum ambient
+// specular fit. templates over the scalar type T (float or Lanes) and a 3-vector type V with
+// members x, y, z of type T (render/shading_math.h).
 
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/shading_math.h"

@@ -156,17 +156,16 @@ TEST(RealtimeHostPathFrames, TendonsAreDrawnAsTheCpuBackendDrawsThem) {
   EXPECT_LE(realtime_parity::DepthMismatch(want.depth_m, got.depth_m), 0.001);
 }
 
-// the kernels shade from the material terms the geometry pass kept (ShadeRealtimeStored,
-// RealtimeKernelOptions::reuse_surface) instead of evaluating the surface again: the same
+// the kernels shade from the material terms the geometry pass kept (ShadeRealtimeStored)
+// instead of evaluating the surface again: the same
 // radiance, rgb and depth bits, in the default room (planar textures, mirror floor) and the
 // house (textured floors and walls, normal maps); so do the lights' terms kept in an array
-// interleaved over a row's pixels (StridedLightTerms, RealtimeKernelOptions::shared_light_terms)
-// and the shadow rays apart in three passes (RealtimeKernelOptions::queue_shadow_rays:
+// interleaved over a row's pixels (StridedLightTerms, as the shading kernel's shared memory)
+// and the shadow rays apart in three passes (the kernels' queued shadow rays:
 // ShadeQueuedStored, the rays traced from the queue's entries, SumQueuedLights), whose sum keeps
 // light order: summed from the last light to the first, the radiance and EV100 differ in both;
 // and so does the shared visibility worked by 16x16 shadow tiles, each tile's arrays copied as
-// the kernels copy them into shared memory (RealtimeKernelOptions::tile_penumbra and
-// tile_visibility; 120 rows: the last row of tiles is cut at 8).
+// the kernels copy them into shared memory (120 rows: the last row of tiles is cut at 8).
 TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
   for (const char* world : {"default.yaml", "house.yaml"}) {
     const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(world, 1.0, 160, 120);
@@ -392,8 +391,8 @@ TEST(RealtimeHostPathFrames, WindowSumsInIntegersGiveTheFloatSumsBits) {
   EXPECT_GT(fractions_seen, 100000);  // the fractions vary: not a comparison of constants
 }
 
-// the staged window of RealtimeKernelOptions::staged_window against the unstaged forms written out
-// here: on random 16x16 tiles (cut to 9 .. 16 columns and rows, as the
+// the staged window (the visibility kernel's shared-memory copy of a tile) against the unstaged
+// forms written out here: on random 16x16 tiles (cut to 9 .. 16 columns and rows, as the
 // image's edges cut them) of surfaces and of one light's verdicts (-1, 0, 1; a third of the
 // tiles all visible but for misses), every pixel's window mask over the tile's copied surfaces
 // (TileWindowSurfaces) is the mask read from the PixelGeometry records (the old loop:

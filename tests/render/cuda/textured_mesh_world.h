@@ -98,9 +98,9 @@ inline CameraView View(const SceneDescription& scene, const WorldSnapshot& snap,
   return view;
 }
 
-/// `scene` as the GPU path drew it before branch gpu9: the mesh's vertex normals, texture
-/// coordinates, the ball's and the box's textures and the normal map dropped (flat,
-/// untextured), for tests that check their threshold tells the two apart.
+/// `scene` with the mesh's vertex normals, texture coordinates, the ball's and the box's
+/// textures and the normal map dropped (flat, untextured), for tests that check their
+/// threshold tells the two apart.
 inline SceneDescription FlatUntextured(const SceneDescription& scene) {
   SceneDescription s = scene;
   for (TriangleMesh& m : s.meshes) m.normals.clear(), m.texcoords.clear();

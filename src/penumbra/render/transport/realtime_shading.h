@@ -275,7 +275,7 @@ struct LocalLightTerms {
 };
 
 /// LocalLightTerms in memory the caller owns, interleaved over `stride` threads (the shading
-/// kernel's shared memory, RealtimeKernelOptions::shared_light_terms): float k (0 .. 6: c, wi,
+/// kernel's shared memory): float k (0 .. 6: c, wi,
 /// dist) of light j at at[(kLightTermFloats j + k) stride], `at` the block's array plus the
 /// thread's index, so a warp's lanes touch consecutive words. the same values as
 /// LocalLightTerms, so the same bits.
@@ -473,7 +473,7 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int 
 }
 
 /// the most lights a frame may have for its shadow rays to go through a queue
-/// (RealtimeKernelOptions::queue_shadow_rays: a pixel's lights are bits of 32-bit masks).
+/// (the shading kernels' queued shadow rays: a pixel's lights are bits of 32-bit masks).
 constexpr int kMaxQueuedShadowLights = 32;
 
 /// what ShadeQueuedLights leaves of a pixel for SumQueuedLights: the lights whose unshadowed
@@ -513,9 +513,9 @@ PB_HOST_DEVICE inline TraceRay QueuedRay(const QueuedShadowRay& r) {
 }
 
 /// ShadeRealtimePoint up to its shadow rays (f.num_lights <= kMaxQueuedShadowLights), pass 1
-/// of 3 of the queued shadow rays (RealtimeKernelOptions::queue_shadow_rays): the unshadowed
-/// terms and total as there, every lit light's contribution kept in f.area_c at [j n + pixel],
-/// each shadow ray that ShadeRealtimePoint traces handed to queue.Push(j, ray) instead, in
+/// of 3 of the queued shadow rays (ShadeQueuedKernel, TraceQueuedKernel, SumQueuedKernel): the
+/// unshadowed terms and total as there, every lit light's contribution kept in f.area_c at [j n +
+/// pixel], each shadow ray that ShadeRealtimePoint traces handed to queue.Push(j, ray) instead, in
 /// light order; returns the ambient term (the sum's start) and sets *masks. pass 2 traces the
 /// queue (TraceOccluded, any order: each verdict is the ray's own), pass 3 sums the lights
 /// (SumQueuedLights).

@@ -45,7 +45,7 @@ struct FrameWindowSurfaces {
 };
 
 /// a shadow tile's copy of the surfaces FrameWindowSurfaces reads (the GPU's
-/// VisibilityRaysWarpKernel with RealtimeKernelOptions::staged_window: shared memory, one
+/// VisibilityRaysWarpKernel keeps it in shared memory, one
 /// entry a tile pixel, structure of arrays): key the geom of a hit, kNoWindowSurface where
 /// the pixel has none (a miss or outside the image); the normal and point of a hit.
 struct TileWindowSurfaces {
@@ -139,8 +139,8 @@ struct StridedWindowVerdicts {
 };
 
 /// a light's verdicts of a shadow tile as bit rows (kShadowVerdictRows words,
-/// render/shadow_window_math.h; the GPU's VisibilityRaysWarpKernel with
-/// RealtimeKernelOptions::window_verdict_rows: shared memory) around tile pixel (x, y): the
+/// render/shadow_window_math.h; the GPU's VisibilityRaysWarpKernel keeps them in shared
+/// memory) around tile pixel (x, y): the
 /// same values as StridedWindowVerdicts over the tile.
 struct RowWindowVerdicts {
   const uint32_t* rows = nullptr;  ///< kShadowVerdictRows words (ShadowVerdictBits)
