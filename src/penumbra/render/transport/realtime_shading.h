@@ -252,7 +252,7 @@ PB_HOST_DEVICE inline Float3 MediaAttenuated(const RealtimeFrameView& f, int j, 
   return Float3{c.x * T.x, c.y * T.y, c.z * T.z};
 }
 
-/// lights whose unshadowed contribution ShadeRealtimeHit keeps between its two loops (the
+/// lights whose unshadowed contribution ShadeRealtimePoint keeps between its two loops (the
 /// others are evaluated twice).
 constexpr int kShadeCachedLights = 16;
 
@@ -447,11 +447,11 @@ PB_HOST_DEVICE inline void ForEachLitLight(const RealtimeFrameView& f, int u, in
   }
 }
 
-/// ShadeRealtimeHit from the shading point sp of pixel (u, v)'s primary hit and its sky term
-/// (f.sky_term), after f.area_vis is cleared for the pixel: the ambient term, the lights and
-/// their shadow rays, each light attenuated by the frame's media where f.has_media. kMedia
-/// false: for frames known to have none (f.has_media must be 0): the media's code is left out,
-/// so the kernels of frames without media keep their registers. terms: where the lights'
+/// the radiance of pixel (u, v) (ShadeRealtimePixel) from the shading point sp of its primary hit
+/// and its sky term (f.sky_term), after f.area_vis is cleared for the pixel: the ambient term, the
+/// lights and their shadow rays, each light attenuated by the frame's media where f.has_media.
+/// kMedia false: for frames known to have none (f.has_media must be 0): the media's code is left
+/// out, so the kernels of frames without media keep their registers. terms: where the lights'
 /// unshadowed terms wait between the two loops (LocalLightTerms, StridedLightTerms); lights from
 /// terms.capacity() on are evaluated twice. ShadeQueuedLights and SumQueuedLights do the same
 /// with the shadow rays traced apart (the same bits).
@@ -572,17 +572,6 @@ PB_HOST_DEVICE inline Float3 BeginRealtimePixel(const RealtimeFrameView& f, int 
   return f.sky_term[pixel];
 }
 
-/// ShadeRealtimePixel of pixel (u, v) whose primary ray r (PrimaryRay) has the closest hit h
-/// (TraceClosest; the CUDA kernels take it from the geometry pass instead of tracing it again).
-/// every light's unshadowed contribution is evaluated once (kShadeCachedLights of them).
-PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u, int v,
-                                              const TraceRay& r, const TraceHit& h) {
-  const Float3 sky = BeginRealtimePixel(f, u, v);
-  if (h.instance < 0) return sky;
-  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
-  return ShadeRealtimePoint(f, u, v, EvaluateSurface(f, r, h, d_len), sky);
-}
-
 /// the shading point of pixel (u, v) from what the geometry pass kept of it: its primary
 /// geometry g (a hit) and material terms t (PrimaryGeometry's surface_out; the view direction
 /// from PrimaryRay as EvaluateSurface): EvaluateSurface's shading point, without evaluating the
@@ -607,7 +596,7 @@ PB_HOST_DEVICE inline ShadingPoint StoredShadingPoint(const RealtimeFrameView& f
   return sp;
 }
 
-/// ShadeRealtimeHit of pixel (u, v) from what the geometry pass kept of its shading point
+/// ShadeRealtimePixel of pixel (u, v) from what the geometry pass kept of its shading point
 /// (StoredShadingPoint of g and t): the same shading point, so the same radiance. kMedia and
 /// terms: ShadeRealtimePoint's.
 template <bool kMedia = true, class Terms>
@@ -646,12 +635,16 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int
 /// escapes) without the shadowed light of lights with an extent: their unshadowed contribution
 /// and the pixel's own shadow ray's verdict go to f.area_c and f.area_vis, resolved by
 /// SharedVisibilityRays, SharedVisibilityFraction and SharedVisibilityResolve once every pixel
-/// has them (as the CPU's RealtimeIntegrator defers them to ResolveSharedVisibility).
+/// has them (as the CPU's RealtimeIntegrator defers them to ResolveSharedVisibility). every
+/// light's unshadowed contribution is evaluated once (kShadeCachedLights of them).
 PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int u, int v) {
   const TraceRay r = PrimaryRay(f.camera, u, v);
   TraceHit h;
   TraceClosest(f.scene, r, &h);
-  return ShadeRealtimeHit(f, u, v, r, h);
+  const Float3 sky = BeginRealtimePixel(f, u, v);
+  if (h.instance < 0) return sky;
+  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  return ShadeRealtimePoint(f, u, v, EvaluateSurface(f, r, h, d_len), sky);
 }
 
 }  // namespace penumbra::cuda

@@ -119,11 +119,11 @@ PB_HOST_DEVICE inline uint32_t SharedVisibilityWindow(const RealtimeFrameView& f
 
 /// a light's verdicts around a pixel as SharedVisibilityPenumbra reads them: the pixel's own at
 /// vis[at], its window neighbour (dx, dy)'s at vis[at + dy stride + dx] (the frame's f.area_vis
-/// + j n, or a tile's int8 copy).
+/// + j n).
 struct StridedWindowVerdicts {
   const int8_t* vis = nullptr;  ///< 1 visible, 0 occluded, -1 none traced
   int64_t at = 0;               ///< the pixel's own entry
-  int64_t stride = 0;           ///< the entries of one row (the image's width, or 16)
+  int64_t stride = 0;           ///< the entries of one row (the image's width)
   /// the pixel's own verdict: 1, 0 or -1.
   PB_HOST_DEVICE int Own() const { return vis[at]; }
   /// whether the window mask `bits` holds a verdict 1 (seen[1]) and 0 (seen[0]): each set bit's
@@ -140,8 +140,8 @@ struct StridedWindowVerdicts {
 
 /// a light's verdicts of a shadow tile as bit rows (kShadowVerdictRows words,
 /// render/shadow_window_math.h; the GPU's VisibilityRaysWarpKernel keeps them in shared
-/// memory) around tile pixel (x, y): the
-/// same values as StridedWindowVerdicts over the tile.
+/// memory) around tile pixel (x, y): the same values as StridedWindowVerdicts over the
+/// frame's f.area_vis.
 struct RowWindowVerdicts {
   const uint32_t* rows = nullptr;  ///< kShadowVerdictRows words (ShadowVerdictBits)
   int x = 0, y = 0;                ///< the pixel in its tile (column, row)
@@ -162,7 +162,7 @@ struct RowWindowVerdicts {
 /// tile's outer ring the pixel's own points - 1 more (f.area_own set: that pixel keeps its own
 /// fraction), else max(1, points / kLightStrata) - 1 more after its first. writes f.area_own.
 /// the window's verdicts of light j come from `w` (Own, Seen): StridedWindowVerdicts over the
-/// frame's f.area_vis or a tile's copy, or RowWindowVerdicts over a tile's bit rows.
+/// frame's f.area_vis, or RowWindowVerdicts over a tile's bit rows.
 template <class Verdicts>
 PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbraOf(const RealtimeFrameView& f, int u,
                                                               int v, int j, uint32_t bits,
@@ -197,22 +197,15 @@ PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbraOf(const RealtimeFram
   return job;
 }
 
-/// SharedVisibilityPenumbraOf with the window's verdicts of light j read at vis_j[at + dy stride
-/// + dx] (the pixel's own at vis_j[at]): f.area_vis + j n with at the pixel's index and stride
-/// the image's width, or a tile's copy (StridedWindowVerdicts).
-PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameView& f, int u,
-                                                            int v, int j, uint32_t bits,
-                                                            const int8_t* vis_j, int64_t at,
-                                                            int64_t stride) {
-  return SharedVisibilityPenumbraOf(f, u, v, j, bits, StridedWindowVerdicts{vis_j, at, stride});
-}
-
-/// SharedVisibilityPenumbra with the window's verdicts read from the frame's f.area_vis.
+/// SharedVisibilityPenumbraOf with the window's verdicts of light j read from the frame's
+/// f.area_vis (StridedWindowVerdicts).
 PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameView& f, int u,
                                                             int v, int j, uint32_t bits) {
   const int64_t n = static_cast<int64_t>(f.camera.width) * f.camera.height;
-  return SharedVisibilityPenumbra(f, u, v, j, bits, f.area_vis + j * n,
-                                  static_cast<int64_t>(v) * f.camera.width + u, f.camera.width);
+  return SharedVisibilityPenumbraOf(
+      f, u, v, j, bits,
+      StridedWindowVerdicts{f.area_vis + j * n, static_cast<int64_t>(v) * f.camera.width + u,
+                            f.camera.width});
 }
 
 /// penumbra ray r (1 <= r < job.extra) of light j (SharedVisibilityPenumbra): -1 where no ray
