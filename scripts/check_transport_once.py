@@ -47,7 +47,7 @@ DEFINITION_RE = re.compile(
 KNOWN = {
     ("render/cpu/mirror_layer.cc", "ApplyMirrorLayer"):
         "the realtime tier's CPU chain (16-wide lanes over Embree packets) is not yet written "
-        "over render/transport; the scalar chain on the CPU measured 5-7x slower",
+        "over render/transport; the scalar chain on the CPU measured 5-9x slower (docs/journal/2026-11-29-transport-design.md)",
 }
 KEYWORDS = {"if", "for", "while", "switch", "return", "sizeof", "catch", "do", "else", "case"}
 
