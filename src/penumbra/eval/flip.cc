@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/srgb.h"
 
 namespace penumbra {
 namespace {
@@ -195,11 +196,7 @@ FlipColourSpace MakeFlipColourSpace() {
     cs.white[r] = static_cast<float>(W(r));
     cs.inv_white[r] = static_cast<float>(1.0 / W(r));
   }
-  for (int i = 0; i < 256; ++i) {
-    const double s = i / 255.0;
-    cs.decode[i] =
-        static_cast<float>(s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4));
-  }
+  for (int i = 0; i < 256; ++i) cs.decode[i] = static_cast<float>(SrgbToLinear(i / 255.0));
   return cs;
 }
 
