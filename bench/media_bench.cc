@@ -17,7 +17,7 @@
 
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/media_common.h"
+#include "penumbra/render/media/media_common.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"

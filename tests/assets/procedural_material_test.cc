@@ -81,7 +81,7 @@ TEST(ProceduralMaterial, MapsVaryAndStayPlausible) {
     const std::vector<uint8_t>& a = m.albedo->rgb_srgb();
     const std::vector<uint8_t>& n = m.normal->rgb_srgb();
     const std::vector<uint8_t>& r = m.metal_roughness->rgb_srgb();
-    // data maps hold sRGB-encoded values (render/material_eval.h, "PBR maps")
+    // data maps hold sRGB-encoded values (render/material/material_eval.h, "PBR maps")
     const float* decode = SrgbDecodeTable();
     double mean = 0, sq = 0, lo_r = 1, hi_r = 0;
     int tilted = 0;

@@ -1,7 +1,7 @@
-// height fields from ray casts (render/height_field_sampling.h) written as MuJoCo hfield models
-// (assets/height_field_model.h): a terrain mesh z = f(x, y) sampled from above matches f
-// at the samples and, between them, within one cell's slope error; MuJoCo places the written
-// hfield where the samples say (a ball dropped on it rests at f + r); a quadruped trots across.
+// height fields from ray casts (render/geometry/height_field_sampling.h) written as MuJoCo hfield
+// models (assets/height_field_model.h): a terrain mesh z = f(x, y) sampled from above matches f at
+// the samples and, between them, within one cell's slope error; MuJoCo places the written hfield
+// where the samples say (a ball dropped on it rests at f + r); a quadruped trots across.
 
 #include "penumbra/assets/height_field_model.h"
 
@@ -17,8 +17,8 @@
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/height_field_sampling.h"
-#include "penumbra/render/static_geometry.h"
+#include "penumbra/render/geometry/height_field_sampling.h"
+#include "penumbra/render/geometry/static_geometry.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 

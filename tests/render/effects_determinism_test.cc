@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "media_test_util.h"
+#include "render/media_test_util.h"
 
 namespace penumbra {
 namespace {

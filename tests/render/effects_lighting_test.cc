@@ -5,9 +5,9 @@
 
 #include <cmath>
 
-#include "media_test_util.h"
-#include "penumbra/render/material_eval.h"
-#include "penumbra/render/sky_model.h"
+#include "penumbra/render/material/material_eval.h"
+#include "penumbra/render/sky/sky_model.h"
+#include "render/media_test_util.h"
 
 namespace penumbra {
 namespace {

@@ -9,14 +9,14 @@
 #include <cstring>
 #include <limits>
 
-#include "media_test_util.h"
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/embree/particle_scene.h"
 #include "penumbra/render/embree/ray_scene.h"
-#include "penumbra/render/light_sampler.h"
-#include "penumbra/render/media_realtime.h"
-#include "penumbra/render/media_scene.h"
+#include "penumbra/render/light/light_sampler.h"
+#include "penumbra/render/media/media_realtime.h"
+#include "penumbra/render/media/media_scene.h"
+#include "render/media_test_util.h"
 
 namespace penumbra::testing {
 namespace {

@@ -1,8 +1,9 @@
-// the shared scalar formulas that replaced Eigen code round as Eigen does (render/bsdf_math.h's
-// EigenDot, render/light_math.h's DotAs<true>, render/emitter_math.h's EmitterDot,
-// EmitterNormalize, PoseApply and RotateApply): checked bit for bit against Eigen on random
-// inputs, so that a change of Eigen or of the compiler that moves its rounding (and with it the
-// CPU's pathtraced images, which these formulas must keep) fails here first.
+// the shared scalar formulas that replaced Eigen code round as Eigen does
+// (render/light/bsdf_math.h's EigenDot, render/light/light_math.h's DotAs<true>,
+// render/light/emitter_math.h's EmitterDot, EmitterNormalize, PoseApply and RotateApply): checked
+// bit for bit against Eigen on random inputs, so that a change of Eigen or of the compiler that
+// moves its rounding (and with it the CPU's pathtraced images, which these formulas must keep)
+// fails here first.
 
 #include <gtest/gtest.h>
 
@@ -12,9 +13,9 @@
 #include <random>
 
 #include "penumbra/core/pose.h"
-#include "penumbra/render/bsdf_math.h"
-#include "penumbra/render/emitter_math.h"
-#include "penumbra/render/light_math.h"
+#include "penumbra/render/light/bsdf_math.h"
+#include "penumbra/render/light/emitter_math.h"
+#include "penumbra/render/light/light_math.h"
 
 namespace penumbra {
 namespace {

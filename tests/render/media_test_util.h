@@ -7,7 +7,7 @@
 
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/scene/effects_frame.h"
-#include "render_test_util.h"
+#include "render/render_test_util.h"
 
 namespace penumbra::testing {
 

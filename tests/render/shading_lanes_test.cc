@@ -9,7 +9,7 @@
 
 #include "penumbra/core/rng.h"
 #include "penumbra/render/cpu/bsdf_lanes.h"
-#include "penumbra/render/light_sampler.h"
+#include "penumbra/render/light/light_sampler.h"
 
 namespace penumbra {
 namespace {

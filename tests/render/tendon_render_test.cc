@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "penumbra/render/backends/renderer_factory.h"
-#include "render_test_util.h"
+#include "render/render_test_util.h"
 
 namespace penumbra {
 namespace {

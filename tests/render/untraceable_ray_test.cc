@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "penumbra/render/embree/ray_scene.h"
-#include "render_test_util.h"
+#include "render/render_test_util.h"
 
 namespace penumbra {
 namespace {

@@ -31,8 +31,8 @@
 #include <vector>
 
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/camera.h"
-#include "penumbra/render/camera_distortion.h"
+#include "penumbra/render/camera/camera.h"
+#include "penumbra/render/camera/camera_distortion.h"
 #include "penumbra/render/renderer.h"
 
 namespace penumbra {

@@ -11,7 +11,7 @@
 #include "camera_sensor_test_util.h"
 #include "penumbra/core/error.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/camera_distortion.h"
+#include "penumbra/render/camera/camera_distortion.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/sensors/camera_lens_droplets.h"
 

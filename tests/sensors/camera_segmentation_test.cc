@@ -9,7 +9,7 @@
 
 #include "camera_sensor_test_util.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/renderer.h"
 
 namespace penumbra {

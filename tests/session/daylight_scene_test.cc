@@ -1,7 +1,7 @@
 // the bare-model default scene is lit by daylight by the numbers (the sun's
-// direct-normal and the sky's diffuse illuminance, render/sky_math.h), so a box's sun shadow on a
-// clear day is as dark as measured ratios say; and the model's MJCF skybox is the environment
-// the camera and a mirror floor see (as MuJoCo draws it).
+// direct-normal and the sky's diffuse illuminance, render/sky/sky_math.h), so a box's sun shadow on
+// a clear day is as dark as measured ratios say; and the model's MJCF skybox is the environment the
+// camera and a mirror floor see (as MuJoCo draws it).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,8 +10,8 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/render/sky_math.h"
-#include "penumbra/render/sky_model.h"
+#include "penumbra/render/sky/sky_math.h"
+#include "penumbra/render/sky/sky_model.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 

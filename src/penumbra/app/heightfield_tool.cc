@@ -12,8 +12,8 @@
 #include "penumbra/core/output_file.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/height_field_sampling.h"
-#include "penumbra/render/static_geometry.h"
+#include "penumbra/render/geometry/height_field_sampling.h"
+#include "penumbra/render/geometry/static_geometry.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 

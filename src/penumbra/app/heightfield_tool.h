@@ -1,9 +1,9 @@
 #pragma once
 // `penumbra heightfield WORLD`: the ground of a world (or the static geoms the user names)
 // sampled from above with the renderer's ray queries (Embree) into a MuJoCo hfield model
-// (render/height_field_sampling.h, assets/height_field_model.h, docs/environments.md "Height
-// fields"): writes OUT/<name>.hfield and OUT/<name>.xml and prints which geoms it sampled, the
-// grid and its error against the geometry at the cell centres.
+// (render/geometry/height_field_sampling.h, assets/height_field_model.h, docs/environments.md
+// "Height fields"): writes OUT/<name>.hfield and OUT/<name>.xml and prints which geoms it sampled,
+// the grid and its error against the geometry at the cell centres.
 
 #include <array>
 #include <optional>
@@ -37,7 +37,8 @@ struct HeightFieldOptions {
 /// ground or a terrain ("*floor*", "*ground*", "*terrain*", matched case-insensitively).
 const std::vector<std::string>& GroundGeomGlobs();
 
-/// the static geoms (`statics`: render/static_geometry.h StaticGeoms) a height field samples:
+/// the static geoms (`statics`: render/geometry/static_geometry.h StaticGeoms) a height field
+/// samples:
 ///  - `all`: every one;
 ///  - else those of `model` (when set) whose name matches a glob of `geoms` (when set);
 ///  - with neither `model` nor `geoms` (the default): the ground, i.e. planes, height fields and

@@ -1,5 +1,5 @@
 #pragma once
-// a height field (render/height_field_sampling.h) as MuJoCo reads it: the custom binary
+// a height field (render/geometry/height_field_sampling.h) as MuJoCo reads it: the custom binary
 // hfield file (MuJoCo XML reference, <hfield file>: "int32 nrow, int32 ncol, float32
 // data[nrow*ncol]", row-major, row 0 at -size_y) and an MJCF model of one hfield geom that
 // reproduces the samples: elevations normalised to [0, 1], size = (half extent x, half extent
@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "penumbra/render/height_field_sampling.h"
+#include "penumbra/render/geometry/height_field_sampling.h"
 
 namespace penumbra {
 

@@ -25,7 +25,7 @@
 // texture images: PNG or JPEG, external (relative to the mesh file) or embedded (.glb, FBX),
 // decoded with OpenCV imgcodecs to 8-bit RGB; alpha is dropped (alpha modes are not
 // supported: every surface is opaque). data maps (normal, metallic-roughness, occlusion) are
-// stored as the renderer keeps every map (render/material_eval.h, "PBR maps"): each value
+// stored as the renderer keeps every map (render/material/material_eval.h, "PBR maps"): each value
 // v = code / 255 sRGB-encoded (EncodeSrgb8), so that mip levels average the values; the
 // normal scale (x and y of 2 v - 1 times it) and the occlusion strength (1 + s (o - 1)) are
 // applied to the texels here.

@@ -301,7 +301,7 @@ void ApplyImportedMaterials(const std::vector<ImportedModel>& models, SceneDescr
         scene->textures.push_back(std::move(t));
         return static_cast<int>(scene->textures.size()) - 1;
       };
-      // the maps by name (render/material_eval.h, "PBR maps")
+      // the maps by name (render/material/material_eval.h, "PBR maps")
       m.texture = add(mat.base_color, "base_color");
       add(mat.normal, "normal");
       add(mat.metallic_roughness, "metallic_roughness");

@@ -21,7 +21,7 @@
 #include "penumbra/assets/mesh_import.h"
 #include "penumbra/decompose/mesh_io.h"
 #include "penumbra/decompose/solid_mesh.h"
-#include "penumbra/render/height_field_sampling.h"
+#include "penumbra/render/geometry/height_field_sampling.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/world/world_config.h"
 
@@ -75,7 +75,7 @@ std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::str
                           const MeshModelCollision& collision = {});
 
 /// the height field of `asset`'s triangles (model frame) sampled from above every `cell_m`
-/// over their plan bounds with an Embree RayQuery (render/height_field_sampling.h).
+/// over their plan bounds with an Embree RayQuery (render/geometry/height_field_sampling.h).
 /// @throws Error if the asset has no triangles or the grid is too large.
 SampledHeightField SampleMeshHeightField(const ImportedAsset& asset, double cell_m);
 
@@ -96,7 +96,7 @@ std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
 /// gives every material "<model>/<name>" of `scene` that an imported model defines its
 /// factors and images: base_color, roughness, metallic, emission, the base colour texture
 /// (Material::texture), and the normal, metallic-roughness, occlusion and emissive maps as 2d
-/// textures named "<model>/<name>/normal", ... (render/material_eval.h, "PBR maps").
+/// textures named "<model>/<name>/normal", ... (render/material/material_eval.h, "PBR maps").
 /// @throws Error when such a material is missing from the scene (a composer bug).
 void ApplyImportedMaterials(const std::vector<ImportedModel>& models, SceneDescription* scene);
 

@@ -330,7 +330,7 @@ ProceduralMaps GenerateProceduralMaterial(const ProceduralMaterialConfig& config
       const Texel tx = (gen.*fn)((x + 0.5f) / n, (y + 0.5f) / n);
       const size_t i = static_cast<size_t>(y) * n + x;
       for (int c = 0; c < 3; ++c) albedo[3 * i + c] = EncodeSrgb8(tx.albedo[c]);
-      // data maps hold sRGB-encoded values (render/material_eval.h, "PBR maps")
+      // data maps hold sRGB-encoded values (render/material/material_eval.h, "PBR maps")
       mr[3 * i] = 0;
       mr[3 * i + 1] = EncodeSrgb8(tx.roughness);
       mr[3 * i + 2] = EncodeSrgb8(tx.metallic);

@@ -29,7 +29,7 @@
 namespace penumbra {
 
 /// the maps of one procedural material and the image side they tile with. the data maps hold
-/// sRGB-encoded values (render/material_eval.h, "PBR maps").
+/// sRGB-encoded values (render/material/material_eval.h, "PBR maps").
 struct ProceduralMaps {
   std::shared_ptr<const TextureImage> albedo;           ///< sRGB colour
   std::shared_ptr<const TextureImage> metal_roughness;  ///< G roughness, B metallic
@@ -66,7 +66,7 @@ ProceduralMaps CachedProceduralMaterial(const ProceduralMaterialConfig& config,
 /// for every `materials:` entry with `procedural:` (ProceduralMaterialsOf), generates its maps
 /// (CachedProceduralMaterial in DefaultCacheDir("materials"), core/cache_dir.h) and
 /// makes them the scene material's: texture (albedo, "<material>/albedo"), and the maps
-/// "<material>/metallic_roughness" and "<material>/normal" (render/material_eval.h, "PBR
+/// "<material>/metallic_roughness" and "<material>/normal" (render/material/material_eval.h, "PBR
 /// maps"), added to scene->textures; base_color 1, roughness and metallic
 /// factors 1 (the maps hold them), texuniform on with texrepeat 2 / size_m (one image per
 /// size_m metres on planes and boxes: MuJoCo repeats a texuniform texture texrepeat / 2 times

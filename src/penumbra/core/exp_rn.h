@@ -2,8 +2,8 @@
 // ExpRn: e^x for a float x, computed by the same IEEE double operations on both processors
 // (MulRnD, AddRnD, rint, ldexp and one rounding to float, all exactly rounded and never
 // contracted), so the CPU and the CUDA backend get the same bits where a decision hangs on an
-// exponential (the rain streaks' culling in media, render/streak_cull_math.h). glibc's expf
-// and CUDA's expf are each within an ulp or two of e^x but not always equal to each other.
+// exponential (the rain streaks' culling in media, render/particles/streak_cull_math.h). glibc's
+// expf and CUDA's expf are each within an ulp or two of e^x but not always equal to each other.
 //
 // method: Cody and Waite's reduction x = k ln 2 + r with k = rint(x / ln 2), |r| <= ln 2 / 2
 // (W. J. Cody and W. Waite, "Software Manual for the Elementary Functions", 1980, ch. 6), e^r by

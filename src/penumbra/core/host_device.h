@@ -20,7 +20,7 @@
 // __fmul_rn, __fadd_rn and __fsub_rn, which nvcc never contracts into a fused multiply-add (it
 // contracts a * b + c by default; the host compiles with -ffp-contract=off), for the code whose
 // GPU results must be the CPU's bits (the realtime splat's ray-capsule test in
-// render/particle_math.h: a grazing ray must meet the capsule on both or on neither).
+// render/particles/particle_math.h: a grazing ray must meet the capsule on both or on neither).
 PB_HOST_DEVICE inline float MulRn(float a, float b) {
 #if defined(__CUDA_ARCH__)
   return __fmul_rn(a, b);

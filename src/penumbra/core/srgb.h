@@ -12,7 +12,7 @@
 //
 // both are templates over the number type (float or double) and evaluate every step in it, so
 // a caller picks its precision by the argument type: the 8-bit tables (scene/texture_image.cc,
-// render/film.cc) are built in double, MJCF colours are decoded in float
+// render/film/film.cc) are built in double, MJCF colours are decoded in float
 // (physics/scene_extractor.cc). float arguments meant for the double formula need an explicit
 // LinearToSrgb<double>(x).
 

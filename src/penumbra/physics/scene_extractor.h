@@ -11,7 +11,7 @@
 //   roughness   = clamp(1 - shininess, 0.05, 1): MuJoCo's Phong shininess maps to smoothness.
 //   reflectance = clamp(reflectance, 0, 1): the weight of a mirror layer that both render tiers
 //               draw on planes and the +z faces of boxes, where MuJoCo draws its reflections
-//               (render/material_eval.h, SurfaceMaterial::mirror).
+//               (render/material/material_eval.h, SurfaceMaterial::mirror).
 //   specular    = specular (MuJoCo's default 0.5 is the glTF/Burley default, F0 = 0.04).
 //   metallic    = 0 (MJCF has no metal notion).
 //   emission    = emission * base_color * kMjcfEmissionLuminance (cd/m^2).

@@ -1,12 +1,12 @@
 #pragma once
 // the backend-neutral ray-query interface: closest hits of batches of rays against the
 // geometry the cameras see, posed from a WorldSnapshot. the LiDAR (sensors/lidar_scanner.h) and
-// the sky irradiance volume (render/sky_irradiance_volume.h) trace only through it, so that a
+// the sky irradiance volume (render/sky/sky_irradiance_volume.h) trace only through it, so that a
 // new backend (e.g. a GPU ray tracer) implements RayQuery next to its Renderer and the sensors
 // stay untouched. the shape follows pbrt-v4's Primitive::Intersect / IntersectP, batched as
 // wavefront and GPU tracers consume rays; it holds only what its users call (closest hits and
 // occlusion of ray batches, posing, the scene). the realtime media's light volumes
-// (render/media_realtime.h) trace their shadow rays through Occluded.
+// (render/media/media_realtime.h) trace their shadow rays through Occluded.
 //
 // implementations: RayScene (Embree 3, render/embree/ray_scene.h). MakeRayQuery
 // (render/backends/renderer_factory.h) builds the one RenderSettings::backend names.

@@ -18,7 +18,8 @@ struct RenderSettings {
   };
   Backend backend = Backend::kAuto;
   enum class Tier {
-    kRealtime,    ///< direct lighting with ray-traced (hard or soft) shadows + sky ambient, 1 sample/pixel
+    kRealtime,    ///< direct lighting with ray-traced (hard or soft) shadows + sky ambient, 1
+                  ///< sample/pixel
     kPathtraced,  ///< unidirectional path tracing, NEE with MIS, N samples/pixel, denoised
   };
   Tier tier = Tier::kRealtime;
@@ -31,8 +32,8 @@ struct RenderSettings {
   double exposure_compensation_ev = 0;  ///< added to the (auto or manual) exposure, in stops
   enum class ToneMap { kFilmic, kLinear };
   ToneMap tone_map = ToneMap::kFilmic;  ///< filmic: ACES fit (Narkowicz 2015); linear: clamp
-  uint64_t seed = 0;           ///< world seed; per-pixel randomness = f(seed, frame, pixel, sample)
-  /// most trilinear taps of an anisotropic texture lookup (render/material_eval.h,
+  uint64_t seed = 0;  ///< world seed; per-pixel randomness = f(seed, frame, pixel, sample)
+  /// most trilinear taps of an anisotropic texture lookup (render/material/material_eval.h,
   /// "filtering"); 1 = isotropic trilinear filtering. both tiers.
   int max_anisotropy = 16;
 

@@ -12,7 +12,7 @@
 #include <utility>
 
 #include "penumbra/core/image.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/scene/effects_frame.h"
 #include "penumbra/scene/scene_description.h"
@@ -29,14 +29,14 @@ struct CameraView {
   int camera_index = 0;     ///< index in SceneDescription::cameras, keys the random numbers too
   double exposure_time_sec = 0.01;  ///< shutter open time from the snapshot's time (streaks, blur)
   /// optical-frame motion for this render (rolling shutter, motion-blur sub-frames); default
-  /// = a camera fixed at X_WO (render/camera.h).
+  /// = a camera fixed at X_WO (render/camera/camera.h).
   CameraMotion motion;
   /// near clipping distance, m, as z-depth along the optical axis: geometry nearer than this
   /// is not seen (the role of MuJoCo's znear; no lens focuses this close). it also keeps the
   /// camera's own housing, whose bounding box holds the optical centre, out of every primary
   /// ray's traversal. >= 0.
   double near_m = 0.01;
-  /// white balance gains (linear rgb, render/white_balance.h) multiplied into the exposure of
+  /// white balance gains (linear rgb, render/film/white_balance.h) multiplied into the exposure of
   /// each channel when rgb is developed (Film::Develop's wb_gains); ones = none. CameraImager
   /// sets them when they are known before the frame (modes daylight, kelvin) so that the
   /// renderer's rgb is the camera's and is not developed a second time.

@@ -85,8 +85,8 @@ struct ParticleSet {
   std::vector<float> radius_m;              ///< (N) m
   Eigen::Vector3f color{1, 1, 1};           ///< albedo (rain, snow) in [0, 1]
   Eigen::Vector3f emission{0, 0, 0};        ///< cd/m^2 per channel (sparks)
-  /// rain and snow: true = not drawn where static geometry is above (render/shelter_map.h);
-  /// false = drawn everywhere. sparks are never sheltered.
+  /// rain and snow: true = not drawn where static geometry is above
+  /// (render/particles/shelter_map.h); false = drawn everywhere. sparks are never sheltered.
   bool sheltered = true;
 };
 

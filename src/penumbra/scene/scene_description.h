@@ -84,7 +84,7 @@ struct Material {
   float metallic = 0.0f;                         ///< [0, 1]
   float specular = 0.5f;                         ///< dielectric specular scale, 0.5 -> F0 = 0.04
   /// MuJoCo's `reflectance` in [0, 1]: weight of a mirror layer over the surface, on planes
-  /// and the local +z faces of boxes only, as MuJoCo draws it (render/material_eval.h).
+  /// and the local +z faces of boxes only, as MuJoCo draws it (render/material/material_eval.h).
   float reflectance = 0.0f;
   Eigen::Vector3f emission{0, 0, 0};  ///< emitted radiance, cd/m^2 (nits) per channel
   int texture = -1;                   ///< index into SceneDescription::textures, -1 none
@@ -171,7 +171,7 @@ struct CameraIntrinsics {
   /// normalised coordinates (x, y) = (X/Z, Y/Z): r2 = x^2 + y^2,
   /// x_d = x (1 + k1 r2 + k2 r2^2 + k3 r2^3) + 2 p1 x y + p2 (r2 + 2 x^2),
   /// y_d = y (1 + k1 r2 + k2 r2^2 + k3 r2^3) + p1 (r2 + 2 y^2) + 2 p2 x y, then
-  /// (u, v) = (fx x_d + cx, fy y_d + cy). all 0 = ideal pinhole (render/camera.h traces it
+  /// (u, v) = (fx x_d + cx, fy y_d + cy). all 0 = ideal pinhole (render/camera/camera.h traces it
   /// exactly).
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
 

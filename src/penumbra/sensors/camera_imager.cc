@@ -13,7 +13,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/white_balance.h"
+#include "penumbra/render/film/white_balance.h"
 #include "penumbra/sensors/camera_lens_droplets.h"
 #include "penumbra/sensors/image_noise.h"
 

@@ -6,8 +6,8 @@
 // rolling-shutter line time l (sensors/camera_sensor_config.h):
 //   - the frame spans D = T + (H - 1) l. `end` is a snapshot at t1 >= t0 + D (the first physics
 //     step after it); everything that moves is interpolated between `start` and `end` at
-//     a = s / (t1 - t0): the camera pose (position linear, rotation slerp; render/camera.h) per
-//     pixel row, and every body pose X_WB per sub-frame (so moving bodies blur too, but are not
+//     a = s / (t1 - t0): the camera pose (position linear, rotation slerp; render/camera/camera.h)
+//     per pixel row, and every body pose X_WB per sub-frame (so moving bodies blur too, but are not
 //     skewed by the rolling shutter: their poses do not change within one sub-frame).
 //   - sub-frame k (k < n) is rendered at s_k = (k + 0.5) T / n with row v seen at s_k + v l; the
 //     sub-frames' radiance images are averaged (box shutter). without `end` nothing moves.
@@ -20,19 +20,18 @@
 // angle), its red and blue images magnified against green (lateral chromatic aberration) and
 // blurred by a Gaussian PSF, in that order, before anything is metered or exposed.
 //
-// exposure: the renderer's auto or manual EV100 (render/film.h) of the averaged radiance is the
-// target; with auto_exposure_time_constant_sec = tau > 0 the EV used adapts as
-// EV_k = EV_target + (EV_{k-1} - EV_target) exp(-(t_k - t_{k-1}) / tau) (state per camera; the
-// first frame uses its target). the exposed values x = radiance * H(EV) go through the sensor
-// model (sensors/image_noise.h) when noise is enabled, then the film's tone curve and sRGB.
-// with auto_exposure enabled (a camera profile, sensors/camera_profile.h) the target is met by
-// a shutter time and an analog gain within the camera's limits (AutoExposureConfig), metered
-// on a quarter-size render of the capture instant (one more render per frame, 1/16 of the
-// pixels: a camera's statistics grid), so a frame's exposure depends on that frame alone (a
-// replay from any frame reproduces it): the sub-frames span that shutter time, the gain
-// raises the ISO of the sensor model, and the raw values
-// (DN / full scale) are developed with raw full scale at the filmic curve's white
-// (kFilmicWhite), the highlight roll-off.
+// exposure: the renderer's auto or manual EV100 (render/film/film.h) of the averaged radiance is
+// the target; with auto_exposure_time_constant_sec = tau > 0 the EV used adapts as EV_k = EV_target
+// + (EV_{k-1} - EV_target) exp(-(t_k - t_{k-1}) / tau) (state per camera; the first frame uses its
+// target). the exposed values x = radiance * H(EV) go through the sensor model
+// (sensors/image_noise.h) when noise is enabled, then the film's tone curve and sRGB. with
+// auto_exposure enabled (a camera profile, sensors/camera_profile.h) the target is met by a shutter
+// time and an analog gain within the camera's limits (AutoExposureConfig), metered on a
+// quarter-size render of the capture instant (one more render per frame, 1/16 of the pixels: a
+// camera's statistics grid), so a frame's exposure depends on that frame alone (a replay from any
+// frame reproduces it): the sub-frames span that shutter time, the gain raises the ISO of the
+// sensor model, and the raw values (DN / full scale) are developed with raw full scale at the
+// filmic curve's white (kFilmicWhite), the highlight roll-off.
 
 #include <cstdint>
 #include <memory>
@@ -43,9 +42,9 @@
 
 #include "penumbra/core/image.h"
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/film.h"
+#include "penumbra/render/film/film.h"
+#include "penumbra/render/particles/shelter_map.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/render/shelter_map.h"
 #include "penumbra/sensors/camera_sensor_config.h"
 #include "penumbra/sensors/depth_noise.h"
 
@@ -81,7 +80,7 @@ double FrameSpanSec(const CameraSensorConfig& c, int height);
 /// the readout time / height.
 double RowTimeSec(const CameraSensorConfig& c, int height);
 
-/// the exposed value at which the filmic tone curve (render/film_math.h AcesFilmic) reaches
+/// the exposed value at which the filmic tone curve (render/film/film_math.h AcesFilmic) reaches
 /// display white: with auto_exposure the raw full scale is developed at this value.
 double FilmicWhite();
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-#include "penumbra/render/white_balance.h"
+#include "penumbra/render/film/white_balance.h"
 
 namespace penumbra {
 
@@ -63,7 +63,7 @@ struct OpticsConfig {
 };
 
 /// exposure control of a real camera (on when `enabled`): the renderer's auto or manual EV
-/// (render/film.h) is the target, met by a shutter time in [min, max]_exposure_time_sec and an
+/// (render/film/film.h) is the target, met by a shutter time in [min, max]_exposure_time_sec and an
 /// analog gain in [1, max_gain] at the lens's f-number and the sensor's base ISO
 /// (ImageNoiseConfig::base_iso): exposure H = T g base_iso / (100 1.2 N^2) per cd/m^2. past
 /// the limits the image is darker than the target. the film's tone curve is then a highlight
@@ -122,7 +122,7 @@ struct CameraSensorConfig {
   int jpeg_quality = 0;        ///< 0 = lossless; 1..100 = JPEG round trip at this quality
   bool lens_droplets = true;   ///< water drops on the lens while it rains (EffectsFrame kRain)
   int lens_droplet_count = 6;  ///< drops on the lens while it rains, >= 0
-  /// white balance of the rgb image (render/white_balance.h), applied to the linear radiance
+  /// white balance of the rgb image (render/film/white_balance.h), applied to the linear radiance
   /// before exposure and tone map. default daylight: the scene's sky and sun on a horizontal
   /// surface is the illuminant (a camera's daylight preset for the scene's own daylight), so
   /// neutral materials under it come out neutral; gray world (auto) would instead tint a frame

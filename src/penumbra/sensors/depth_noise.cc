@@ -13,7 +13,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
-#include "penumbra/render/media_scene.h"
+#include "penumbra/render/media/media_scene.h"
 #include "penumbra/sensors/image_noise.h"
 
 namespace penumbra {

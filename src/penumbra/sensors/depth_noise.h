@@ -105,7 +105,7 @@
 
 #include "penumbra/core/image.h"
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/scene/effects_frame.h"
 #include "penumbra/sensors/camera_sensor_config.h"
 
@@ -195,7 +195,7 @@ double HomogeneousOpticalDepth(const HomogeneousMedium& medium, const Eigen::Vec
 
 /// one-way transmittance T from the camera to the hit of every pixel of `depth_z`
 /// ((H x W x 1) z-depth, 0 = no hit -> 1) through all media of `effects`: homogeneous media in
-/// closed form, voxel grids (smoke, steam) by ratio tracking (render/media_scene.h,
+/// closed form, voxel grids (smoke, steam) by ratio tracking (render/media/media_scene.h,
 /// MediaScene::Transmittance; an unbiased per-pixel estimate, seeded by Rng(HashKeys(key,
 /// pixel))); channel mean (near-infrared sensors see roughly grey media). the pixel ray comes
 /// from `camera` (distortion and rolling shutter aware).

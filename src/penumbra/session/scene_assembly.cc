@@ -6,8 +6,8 @@
 #include <set>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/sky_math.h"
-#include "penumbra/render/sky_model.h"
+#include "penumbra/render/sky/sky_math.h"
+#include "penumbra/render/sky/sky_model.h"
 #include "penumbra/scene/scene_limits.h"
 #include "penumbra/scene/world_snapshot.h"
 #include "penumbra/session/geom_extents.h"
@@ -328,7 +328,7 @@ SceneDescription AssembleScene(SceneDescription scene, const WorldConfig& world,
   scene.sky.sun_direction_W = DirectionFromElevationAzimuth(s.sun_elevation_deg, s.sun_azimuth_deg);
 
   if (world.default_lights) {
-    // the bare-model daylight, by the numbers (render/sky_math.h): the sun carries its
+    // the bare-model daylight, by the numbers (render/sky/sky_math.h): the sun carries its
     // direct-normal illuminance at the sky's elevation and turbidity, and the sky's zenith
     // luminance is the one that gives the clear sky's diffuse horizontal illuminance there.
     const float elevation = static_cast<float>(s.sun_elevation_deg);

@@ -2,7 +2,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/static_geometry.h"
+#include "penumbra/render/geometry/static_geometry.h"
 
 namespace penumbra {
 

@@ -1,6 +1,6 @@
 #pragma once
 // the terrain ray caster (control/terrain_ray_caster.h) of a session: vertical rays against
-// the world's static geometry (the world body and static bodies, render/static_geometry.h)
+// the world's static geometry (the world body and static bodies, render/geometry/static_geometry.h)
 // through the RayQuery of the world's render backend (render/ray_query.h), posed once at
 // load. robots and other moving bodies are not hit, so a robot's own legs never shadow its
 // height scan (as Isaac Lab's RayCaster sees only its mesh_prim_paths, the terrain, and

@@ -6,7 +6,7 @@
 #include <set>
 
 #include "penumbra/core/text_match.h"
-#include "penumbra/render/camera_distortion.h"
+#include "penumbra/render/camera/camera_distortion.h"
 #include "penumbra/scene/scene_limits.h"
 #include "penumbra/sensors/camera_profile.h"
 

@@ -5,7 +5,7 @@
 //     profile: ideal                       a named camera (sensors/camera_profile.h); the keys
 //                                           below override its values; absent = ideal
 //     distortion: {k1, k2, p1, p2, k3}     Brown-Conrady, OpenCV names; rejected if it folds
-//                                           the image (render/camera_distortion.h)
+//                                           the image (render/camera/camera_distortion.h)
 //     exposure_time_sec: 0.01              shutter time T (>= 0)
 //     motion_blur_samples: 1               sub-frames over T (1..64)
 //     rolling_shutter_line_time_sec: 0     per-row readout delay (>= 0; 0 = global shutter)

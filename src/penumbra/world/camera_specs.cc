@@ -2,7 +2,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
-#include "penumbra/render/camera_distortion.h"
+#include "penumbra/render/camera/camera_distortion.h"
 #include "penumbra/sensors/camera_profile.h"
 
 namespace penumbra {

@@ -11,7 +11,7 @@ namespace penumbra {
 
 /// sets `cam`'s distortion and exposure time from `c` and checks the distortion against the
 /// final intrinsics. @throws ConfigError (file `file`, key `key`.distortion, naming the camera)
-/// if it folds the image (render/camera_distortion.h).
+/// if it folds the image (render/camera/camera_distortion.h).
 void ApplyCameraConfig(const CameraConfig& c, CameraSpec* cam, const std::string& file,
                        const std::string& key);
 

@@ -28,8 +28,8 @@ struct MeshImportConfig {
   double emissive_cd_m2 = 100;
   /// `collision:` how the mesh collides: "hull" (MuJoCo's convex hull of each mesh of the
   /// file), "heightfield" (a height field of the mesh sampled from above every
-  /// heightfield_cell_m: render/height_field_sampling.h; the mesh itself visual only), "coacd"
-  /// (the file's meshes welded into one closed solid and split into convex parts by CoACD,
+  /// heightfield_cell_m: render/geometry/height_field_sampling.h; the mesh itself visual only),
+  /// "coacd" (the file's meshes welded into one closed solid and split into convex parts by CoACD,
   /// decompose/coacd.h, cached on disk; the mesh itself visual only), "none" (visual only).
   std::string collision = "hull";
   /// `heightfield_cell_m:` sample spacing of `collision: heightfield`, m, in [0.005, 10].

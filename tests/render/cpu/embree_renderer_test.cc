@@ -10,7 +10,7 @@
 #include <set>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "render/render_test_util.h"
 
 namespace penumbra {

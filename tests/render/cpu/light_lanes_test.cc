@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "penumbra/core/rng.h"
-#include "penumbra/render/lamp_math.h"
+#include "penumbra/render/light/lamp_math.h"
 
 namespace penumbra {
 namespace {

@@ -11,7 +11,7 @@
 #include <limits>
 
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/bsdf.h"
+#include "penumbra/render/light/bsdf.h"
 #include "render/render_test_util.h"
 
 namespace penumbra {

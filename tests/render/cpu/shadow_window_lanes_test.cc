@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "penumbra/core/rng.h"
-#include "penumbra/render/shadow_window_math.h"
+#include "penumbra/render/light/shadow_window_math.h"
 
 namespace penumbra {
 namespace {

@@ -23,7 +23,7 @@
 #include "penumbra/render/cuda/bvh_builder.h"
 #include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/embree/ray_scene.h"
-#include "penumbra/render/static_geometry.h"
+#include "penumbra/render/geometry/static_geometry.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 #include "render/render_test_util.h"

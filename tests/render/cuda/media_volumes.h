@@ -1,5 +1,5 @@
 #pragma once
-// the realtime media's light volumes (render/media_realtime.h) of a bundled effects world at
+// the realtime media's light volumes (render/media/media_realtime.h) of a bundled effects world at
 // 1 s built over another RayQuery than the CPU renderer's Embree RayScene (the CUDA backend's
 // BvhRayQuery on the host, CudaRayQuery on the GPU), compared with Embree's: the world light
 // volume's visibility entries and the camera rays' media terms (media_volumes_test.cc,
@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/embree/ray_scene.h"
-#include "penumbra/render/light_sampler.h"
-#include "penumbra/render/media_realtime.h"
-#include "penumbra/render/media_scene.h"
+#include "penumbra/render/light/light_sampler.h"
+#include "penumbra/render/media/media_realtime.h"
+#include "penumbra/render/media/media_scene.h"
 #include "realtime_parity.h"
 
 namespace penumbra::media_volumes {

@@ -1,4 +1,4 @@
-// the realtime media's light volumes (render/media_realtime.h) built over the CUDA backend's
+// the realtime media's light volumes (render/media/media_realtime.h) built over the CUDA backend's
 // traversal instead of Embree: RealtimeMedia takes any RayQuery, so the CUDA backend can build
 // a frame's volumes with the CPU code over its own BVH. here BvhRayQuery (the kernels'
 // PB_HOST_DEVICE traversal run on the host, the reference of CudaRayQuery) against the CPU

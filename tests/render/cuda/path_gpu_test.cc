@@ -84,8 +84,8 @@ INSTANTIATE_TEST_SUITE_P(Bundled, PathtracedGpu,
                                            "default-distorted-moving.yaml"));
 
 // the pathtraced tier's media on the GPU (render/transport/path_trace.h's TracePath<true> over
-// the shared formulas of render/media_scene_math.h): worlds/effects/fog.yaml (homogeneous fog,
-// the rover's camera) and smoke_plume.yaml (a smoke grid, the overview camera, which sees the
+// the shared formulas of render/media/media_scene_math.h): worlds/effects/fog.yaml (homogeneous
+// fog, the rover's camera) and smoke_plume.yaml (a smoke grid, the overview camera, which sees the
 // plume) at 1 s, 128x96, 1024 spp, 4 bounces, no denoiser, against the CPU backend on all
 // cores: the radiance's mean relative difference (8x8 blocks and image mean) <= 1 %, the frame
 // on the GPU (not the CPU fallback), two GPU renders bit-identical.

@@ -19,13 +19,13 @@
 #include "path_parity.h"
 #include "penumbra/core/rng.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/path_frame.h"
-#include "penumbra/render/emitter_sampler.h"
-#include "penumbra/render/media_scene.h"
-#include "penumbra/render/particle_math.h"
+#include "penumbra/render/light/emitter_sampler.h"
+#include "penumbra/render/media/media_scene.h"
+#include "penumbra/render/particles/particle_math.h"
 #include "penumbra/render/transport/path_streaks.h"
 #include "realtime_parity.h"
 
@@ -233,7 +233,7 @@ void PrepareEffectsPath(const MediaFrameCase& c, ThreadPool* pool, EffectsPathFr
 
 // the GPU path with media (TracePath<true>: the free flights' delta tracking, the phase
 // function's next events and samples, the media's transmittance on every shadow ray; the shared
-// formulas of render/media_scene_math.h), run on the CPU, against the CPU backend's
+// formulas of render/media/media_scene_math.h), run on the CPU, against the CPU backend's
 // PathIntegrator: fog (homogeneous; the rover's camera) and smoke_plume (a grid; the overview
 // camera, which sees the plume), 64x48, 16 spp. the paths draw the CPU's random numbers, so
 // they track its estimate closely; without the media (the paths of clear air) the difference

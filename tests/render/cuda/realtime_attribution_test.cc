@@ -28,7 +28,7 @@
 #include "penumbra/render/cpu/embree_renderer.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/realtime_frame.h"
-#include "penumbra/render/film_math.h"
+#include "penumbra/render/film/film_math.h"
 #include "realtime_parity.h"
 
 namespace penumbra {

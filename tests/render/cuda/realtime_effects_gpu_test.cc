@@ -29,7 +29,7 @@
 #include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
 #include "penumbra/render/cuda/realtime_frame.h"
-#include "penumbra/render/particle_math.h"
+#include "penumbra/render/particles/particle_math.h"
 #include "realtime_parity.h"
 
 namespace penumbra {

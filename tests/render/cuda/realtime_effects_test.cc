@@ -21,12 +21,12 @@
 #include "host_path.h"
 #include "penumbra/core/error.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
 #include "penumbra/render/cuda/realtime_frame.h"
-#include "penumbra/render/material_eval.h"
-#include "penumbra/render/wetness_math.h"
+#include "penumbra/render/material/material_eval.h"
+#include "penumbra/render/material/wetness_math.h"
 #include "realtime_parity.h"
 
 namespace penumbra {

@@ -22,7 +22,7 @@
 #include "penumbra/core/rng.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
-#include "penumbra/render/film.h"
+#include "penumbra/render/film/film.h"
 #include "realtime_parity.h"
 
 namespace penumbra {

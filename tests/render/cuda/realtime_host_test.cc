@@ -18,7 +18,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/realtime_frame.h"
 #include "realtime_parity.h"

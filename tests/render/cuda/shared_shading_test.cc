@@ -1,4 +1,4 @@
-// the shared host/device shading formulas (render/brdf_math.h, light_math.h, film_math.h,
+// the shared host/device shading formulas (render/light/brdf_math.h, light_math.h, film_math.h,
 // texture_math.h) run on the CPU: their float instantiations (what the CUDA kernels run) agree
 // with the CPU backend's lane code, which instantiates the same templates with SIMD lanes, to a
 // few ulp (Eigen's vectorised square roots are not the correctly rounded ones), bit for bit
@@ -12,12 +12,12 @@
 #include <vector>
 
 #include "penumbra/core/rng.h"
-#include "penumbra/render/bsdf.h"
 #include "penumbra/render/cpu/bsdf_lanes.h"
-#include "penumbra/render/film.h"
-#include "penumbra/render/light_sampler.h"
-#include "penumbra/render/material_eval.h"
-#include "penumbra/render/texture_math.h"
+#include "penumbra/render/film/film.h"
+#include "penumbra/render/light/bsdf.h"
+#include "penumbra/render/light/light_sampler.h"
+#include "penumbra/render/material/material_eval.h"
+#include "penumbra/render/material/texture_math.h"
 #include "penumbra/scene/texture_image.h"
 
 namespace penumbra {

@@ -1,4 +1,4 @@
-// the drops' shared culling decision (render/streak_cull_math.h's StreakCullDrop),
+// the drops' shared culling decision (render/particles/streak_cull_math.h's StreakCullDrop),
 // which ParticleStreaks::Build and the CUDA backend's device culling (cuda_streak_cull.h) call,
 // on the CPU (no GPU needed): on every drop of the rain and snow frames at 1 s, 640x480, of the
 // rain frame in fog (realtime_parity::AddRainFog: a height fog and a box of haze, rain culled as
@@ -28,9 +28,9 @@
 #include <vector>
 
 #include "host_path.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/cuda/realtime_frame.h"
-#include "penumbra/render/streak_cull_math.h"
+#include "penumbra/render/particles/streak_cull_math.h"
 #include "realtime_parity.h"
 
 namespace penumbra {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
 #include "penumbra/render/embree/ray_scene.h"

@@ -18,13 +18,13 @@
 #include <vector>
 
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/embree/ray_scene.h"
-#include "penumbra/render/material_eval.h"
-#include "penumbra/render/sky_model.h"
+#include "penumbra/render/material/material_eval.h"
+#include "penumbra/render/sky/sky_model.h"
 #include "realtime_parity.h"
 #include "textured_mesh_world.h"
 

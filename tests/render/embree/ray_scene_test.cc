@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/analytic_shapes.h"
-#include "penumbra/render/camera.h"
-#include "penumbra/render/ray_cone.h"
+#include "penumbra/render/camera/camera.h"
+#include "penumbra/render/geometry/analytic_shapes.h"
+#include "penumbra/render/geometry/ray_cone.h"
 #include "render/render_test_util.h"
 
 namespace penumbra {

@@ -31,7 +31,7 @@ struct RainParams {
   /// number density is kept. [1, 5e6]
   int max_particles = 200000;
   Eigen::Vector3d color{0.85, 0.9, 1.0};  ///< drop tint (albedo), [0, 1]
-  /// true: no drop is drawn under static geometry (a roof; render/shelter_map.h); false:
+  /// true: no drop is drawn under static geometry (a roof; render/particles/shelter_map.h); false:
   /// drops fall everywhere, indoors too (a leaking roof, a sprinkler).
   bool sheltered = true;
 

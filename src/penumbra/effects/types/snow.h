@@ -29,7 +29,8 @@ struct SnowParams {
   Eigen::Vector3d box_half_extents_m{4, 4, 3};  ///< each > 0
   int max_particles = 200000;                   ///< [1, 5e6]
   Eigen::Vector3d color{0.95, 0.95, 0.97};      ///< [0, 1]
-  /// true: no flake is drawn under static geometry (render/shelter_map.h); false: everywhere.
+  /// true: no flake is drawn under static geometry (render/particles/shelter_map.h); false:
+  /// everywhere.
   bool sheltered = true;
 
   /// effect-type hooks (effects/effect_type.h).

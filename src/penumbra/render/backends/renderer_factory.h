@@ -46,12 +46,12 @@ std::unique_ptr<RayQuery> MakeRayQuery(const SceneDescription& scene,
                                        RenderSettings::Backend backend);
 
 /// the ray queries over a scene's static geoms that a realtime renderer traces its static maps
-/// through before its first frame (the sky irradiance volume, render/sky_irradiance_volume.h;
-/// the shelter map, render/shelter_map.h): Embree's (RayScene, render/embree/ray_scene.h), as
-/// the CPU backend builds them, for every backend, so a CUDA frame's maps are the CPU's bits
-/// and take Embree's time (docs/journal/2026-11-26-gpu-speed.md, "The static maps through
-/// Embree"). MakeRenderer gives it to the CUDA renderer; a cuda::BatchRenderer whose cameras
-/// must equal MakeRenderer's takes it in BatchConfig::statics_query.
+/// through before its first frame (the sky irradiance volume, render/sky/sky_irradiance_volume.h;
+/// the shelter map, render/particles/shelter_map.h): Embree's (RayScene,
+/// render/embree/ray_scene.h), as the CPU backend builds them, for every backend, so a CUDA frame's
+/// maps are the CPU's bits and take Embree's time (docs/journal/2026-11-26-gpu-speed.md, "The
+/// static maps through Embree"). MakeRenderer gives it to the CUDA renderer; a cuda::BatchRenderer
+/// whose cameras must equal MakeRenderer's takes it in BatchConfig::statics_query.
 RayQueryFactory StaticMapsQueryFactory();
 
 /// the version of `backend`'s ray-tracing library, for run manifests (Embree: its

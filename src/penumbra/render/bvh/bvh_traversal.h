@@ -12,13 +12,13 @@
 // first (occlusion: any order), slab tests of Williams et al., "An efficient and robust ray-box
 // intersection algorithm" (JGT 2005). triangles: Moller and Trumbore, "Fast, minimum storage
 // ray/triangle intersection" (JGT 1997), in float; analytic shapes: IntersectAnalyticArrays
-// (render/analytic_shapes.h) in double in the geom frame, as RayScene.
+// (render/geometry/analytic_shapes.h) in double in the geom frame, as RayScene.
 
 #include <cmath>
 
 #include "penumbra/core/host_device.h"
-#include "penumbra/render/analytic_shape_math.h"
 #include "penumbra/render/bvh/bvh_types.h"
+#include "penumbra/render/geometry/analytic_shape_math.h"
 
 namespace penumbra::cuda {
 

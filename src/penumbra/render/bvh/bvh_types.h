@@ -13,7 +13,7 @@
 #include <cstdint>
 
 #include "penumbra/core/host_device.h"
-#include "penumbra/render/analytic_shape_math.h"
+#include "penumbra/render/geometry/analytic_shape_math.h"
 
 namespace penumbra::cuda {
 
@@ -51,8 +51,8 @@ struct alignas(16) Triangle {
 };
 static_assert(sizeof(Triangle) == 48, "Triangle is three 16-byte loads");
 
-/// an analytic shape (render/analytic_shapes.h) and the map from its group's frame to its own:
-/// p_G = R_GI p_I + p_GI (double, as RayScene).
+/// an analytic shape (render/geometry/analytic_shapes.h) and the map from its group's frame to its
+/// own: p_G = R_GI p_I + p_GI (double, as RayScene).
 struct AnalyticPrim {
   AnalyticKind kind = AnalyticKind::kSphere;
   double size[3] = {1, 1, 1};

@@ -1,6 +1,6 @@
 #include "penumbra/render/cpu/bsdf_lanes.h"
 
-#include "penumbra/render/brdf_math.h"
+#include "penumbra/render/light/brdf_math.h"
 
 namespace penumbra {
 void BsdfLanes::SetCoefficients(const PbrLanes& p) {

@@ -4,7 +4,7 @@
 // realtime tier; agrees with Bsdf::Eval to float rounding (same formulas; sin^2 of the half
 // vector from |h x n|^2 as Bsdf takes it from the local frame).
 
-#include "penumbra/render/bsdf.h"
+#include "penumbra/render/light/bsdf.h"
 #include "penumbra/render/shading_lanes.h"
 
 namespace penumbra {

@@ -7,10 +7,10 @@
 #include <thread>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/camera_ground_truth.h"
+#include "penumbra/render/camera/camera_ground_truth.h"
 #include "penumbra/render/cpu/path_integrator.h"
 #include "penumbra/render/cpu/realtime_integrator.h"
-#include "penumbra/render/ray_cone.h"
+#include "penumbra/render/geometry/ray_cone.h"
 
 namespace penumbra {
 namespace {
@@ -69,11 +69,11 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   effects_.Prepare(snapshot, effects, camera, view, settings_, lights_, *ray_scene_, sky_,
                    &sky_volume_, &pool_);
   // realtime tier: sky light occluded by the static geometry, rebuilt only when the static
-  // bodies move and relit when the sky changes (render/sky_irradiance_volume.h).
+  // bodies move and relit when the sky changes (render/sky/sky_irradiance_volume.h).
   if (settings_.tier == RenderSettings::Tier::kRealtime)
     sky_volume_.Update(scene_, snapshot, *effects_.sky(), &pool_);
   // realtime tier: the sun shadow rays the static boxes block are not traced (same image;
-  // render/sun_occluder_map.h), rebuilt when the static bodies move or the sun turns.
+  // render/sky/sun_occluder_map.h), rebuilt when the static bodies move or the sun turns.
   const bool use_sun_occluders =
       settings_.tier == RenderSettings::Tier::kRealtime && ablation_.sun_occluder;
   if (use_sun_occluders) sun_occluders_.Update(scene_, snapshot, lights_, &pool_);

@@ -13,17 +13,17 @@
 #include <string>
 
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/denoiser.h"
 #include "penumbra/render/cpu/integrator.h"
 #include "penumbra/render/embree/ray_scene.h"
-#include "penumbra/render/film.h"
-#include "penumbra/render/light_sampler.h"
-#include "penumbra/render/material_eval.h"
+#include "penumbra/render/film/denoiser.h"
+#include "penumbra/render/film/film.h"
+#include "penumbra/render/light/light_sampler.h"
+#include "penumbra/render/material/material_eval.h"
 #include "penumbra/render/render_ablation.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/render/sky_irradiance_volume.h"
-#include "penumbra/render/sky_model.h"
-#include "penumbra/render/sun_occluder_map.h"
+#include "penumbra/render/sky/sky_irradiance_volume.h"
+#include "penumbra/render/sky/sky_model.h"
+#include "penumbra/render/sky/sun_occluder_map.h"
 
 namespace penumbra {
 

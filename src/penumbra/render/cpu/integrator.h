@@ -13,16 +13,16 @@
 
 #include "penumbra/core/image.h"
 #include "penumbra/core/rng.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/cpu/media_frame.h"
 #include "penumbra/render/embree/ray_scene.h"
-#include "penumbra/render/light_sampler.h"
-#include "penumbra/render/material_eval.h"
+#include "penumbra/render/light/light_sampler.h"
+#include "penumbra/render/material/material_eval.h"
 #include "penumbra/render/render_ablation.h"
 #include "penumbra/render/render_settings.h"
-#include "penumbra/render/sky_irradiance_volume.h"
-#include "penumbra/render/sky_model.h"
-#include "penumbra/render/sun_occluder_map.h"
+#include "penumbra/render/sky/sky_irradiance_volume.h"
+#include "penumbra/render/sky/sky_model.h"
+#include "penumbra/render/sky/sun_occluder_map.h"
 
 namespace penumbra {
 
@@ -38,10 +38,10 @@ struct FrameContext {
   const LightSampler* lights = nullptr;  ///< posed for this frame
   const SkyModel* sky = nullptr;
   /// the realtime tier's sky light occluded by the static geometry, lit by `sky`
-  /// (render/sky_irradiance_volume.h), or null: then the sky irradiance is unoccluded.
+  /// (render/sky/sky_irradiance_volume.h), or null: then the sky irradiance is unoccluded.
   const SkyIrradianceVolume* sky_volume = nullptr;
   /// the realtime tier's sun shadow rays that the static boxes provably block
-  /// (render/sun_occluder_map.h), or null: then every shadow ray is traced.
+  /// (render/sky/sun_occluder_map.h), or null: then every shadow ray is traced.
   const SunOccluderMap* sun_occluders = nullptr;
   const Camera* camera = nullptr;
   const RenderSettings* settings = nullptr;

@@ -24,7 +24,7 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effe
     particles_.Build(nullptr, camera, 0, StreakRays::kAny);
     return;
   }
-  // sky: moved sun and luminance scale (render/effects_sky.h, shared with the CUDA backend).
+  // sky: moved sun and luminance scale (render/sky/effects_sky.h, shared with the CUDA backend).
   const SkyModel& sky = effects_sky_.Update(scene_.sky, base_sky, fx);
   wetness_ = SurfaceWetnessOf(fx);
   if (&sky != &base_sky) {

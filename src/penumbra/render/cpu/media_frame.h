@@ -7,7 +7,7 @@
 //  - particle streaks for the frame's camera and exposure (ParticleScene), without the
 //    rain and snow that static geometry covers from above (ShelterMap);
 //  - the sky moved to EffectsFrame::sun_direction_W and scaled by sky_luminance_scale, and the
-//    surface wetness (ApplySurfaceWetness, material_eval.h): render/effects_sky.h, which the
+//    surface wetness (ApplySurfaceWetness, material_eval.h): render/sky/effects_sky.h, which the
 //    CUDA backend's realtime path shares.
 // light intensity scales and extra lights are applied by LightSampler::Update.
 
@@ -16,18 +16,18 @@
 #include <optional>
 
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/camera.h"
-#include "penumbra/render/media_realtime.h"
-#include "penumbra/render/effects_sky.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/embree/particle_scene.h"
 #include "penumbra/render/embree/ray_scene.h"
-#include "penumbra/render/light_sampler.h"
-#include "penumbra/render/media_scene.h"
+#include "penumbra/render/light/light_sampler.h"
+#include "penumbra/render/media/media_realtime.h"
+#include "penumbra/render/media/media_scene.h"
+#include "penumbra/render/particles/shelter_map.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/render/shelter_map.h"
-#include "penumbra/render/sky_irradiance_volume.h"
-#include "penumbra/render/sky_model.h"
+#include "penumbra/render/sky/effects_sky.h"
+#include "penumbra/render/sky/sky_irradiance_volume.h"
+#include "penumbra/render/sky/sky_model.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
 

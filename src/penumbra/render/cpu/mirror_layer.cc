@@ -4,14 +4,14 @@
 #include <cmath>
 #include <vector>
 
-#include "penumbra/render/brdf_math.h"
-#include "penumbra/render/bsdf.h"
-#include "penumbra/render/media_common.h"
+#include "penumbra/render/light/brdf_math.h"
+#include "penumbra/render/light/bsdf.h"
+#include "penumbra/render/media/media_common.h"
 
 namespace penumbra {
 namespace {
 
-// the split-sum ambient specular fit (render/brdf_math.h) for one shading point.
+// the split-sum ambient specular fit (render/light/brdf_math.h) for one shading point.
 Eigen::Vector3f EnvBrdfApproxScalar(const Eigen::Vector3f& f0, float n_v, float roughness) {
   const Float3 s = EnvBrdfApprox<float, Float3>(Float3{f0.x(), f0.y(), f0.z()}, n_v, roughness);
   return Eigen::Vector3f(s.x, s.y, s.z);

@@ -19,8 +19,8 @@
 // reflected contrast). the reflection's random numbers are as before (draws num_lights ... of
 // the traced pixel's stream), so the dense layer is bit-identical to the per-pixel one, and so
 // is the whole image of a scene without weak mirrors.
-// the grid, its weights and the blend are render/mirror_math.h's (shared with the CUDA backend).
-// RenderAblation::mirror_sparse = false traces every pixel (bench comparisons).
+// the grid, its weights and the blend are render/light/mirror_math.h's (shared with the CUDA
+// backend). RenderAblation::mirror_sparse = false traces every pixel (bench comparisons).
 //
 // determinism: per tile, independent of thread count and tile order.
 
@@ -28,7 +28,7 @@
 #include <cstdint>
 
 #include "penumbra/render/cpu/integrator.h"
-#include "penumbra/render/mirror_math.h"
+#include "penumbra/render/light/mirror_math.h"
 
 namespace penumbra {
 

@@ -5,8 +5,8 @@
 #include <limits>
 #include <vector>
 
-#include "penumbra/render/bsdf.h"
-#include "penumbra/render/path_math.h"
+#include "penumbra/render/light/bsdf.h"
+#include "penumbra/render/light/path_math.h"
 
 namespace penumbra {
 namespace {
@@ -19,7 +19,7 @@ Float3 F3(const Eigen::Vector3f& v) { return Float3{v.x(), v.y(), v.z()}; }
 Eigen::Vector3f E3(const Float3& v) { return Eigen::Vector3f(v.x, v.y, v.z); }
 
 // a point or spot light with a radius that casts shadows: a sphere that rays can hit (the
-// shared terms of render/path_math.h).
+// shared terms of render/light/path_math.h).
 struct Lamp {
   int light = -1;  // index into LightSampler::lights()
   const LightPod* pod = nullptr;

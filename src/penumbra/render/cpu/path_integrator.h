@@ -26,7 +26,8 @@
 // q = min(1, max channel of its throughput) and is reweighted by 1 / q (unbiased).
 //
 // adverse conditions (FrameContext::effects, render/cpu/media_frame.h), when present:
-//   - participating media (render/media_scene.h): every ray segment is tracked from its origin
+//   - participating media (render/media/media_scene.h): every ray segment is tracked from its
+//   origin
 //     to the surface, lamp or infinity by spectral delta tracking; a real scattering event is
 //     a path vertex (counted against max_bounces, Russian roulette as at surfaces) with the
 //     same next-event estimation as a surface but the media's Henyey-Greenstein phase mixture
@@ -42,9 +43,9 @@
 // without effects the tier draws no extra random numbers: its images do not depend on the
 // effects code.
 //
-// textures are filtered over the pixel's ray cone (render/material_eval.h): its spread angle is
-// Camera::pixel_spread_rad and its width at a vertex is that angle times the length of the path
-// from the camera to the vertex (the cone of a chain of flat mirrors; the paper's spread from
+// textures are filtered over the pixel's ray cone (render/material/material_eval.h): its spread
+// angle is Camera::pixel_spread_rad and its width at a vertex is that angle times the length of the
+// path from the camera to the vertex (the cone of a chain of flat mirrors; the paper's spread from
 // surface curvature and roughness is left out, so after rough bounces the footprint is
 // underestimated and textures are sampled sharper than the cone of the path would need).
 //
@@ -62,7 +63,7 @@
 // samples_per_pixel passes. a render that is not stopped is the same as without the check.
 
 #include "penumbra/render/cpu/integrator.h"
-#include "penumbra/render/emitter_sampler.h"
+#include "penumbra/render/light/emitter_sampler.h"
 
 namespace penumbra {
 

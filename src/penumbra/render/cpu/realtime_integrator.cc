@@ -7,16 +7,16 @@
 #include <limits>
 #include <vector>
 
-#include "penumbra/render/brdf_math.h"
-#include "penumbra/render/bsdf.h"
 #include "penumbra/render/cpu/bsdf_lanes.h"
 #include "penumbra/render/cpu/light_lanes.h"
 #include "penumbra/render/cpu/mirror_layer.h"
 #include "penumbra/render/cpu/shadow_window_lanes.h"
-#include "penumbra/render/lamp_math.h"
-#include "penumbra/render/media_common.h"
-#include "penumbra/render/particle_math.h"
-#include "penumbra/render/shadow_window_math.h"
+#include "penumbra/render/light/brdf_math.h"
+#include "penumbra/render/light/bsdf.h"
+#include "penumbra/render/light/lamp_math.h"
+#include "penumbra/render/light/shadow_window_math.h"
+#include "penumbra/render/media/media_common.h"
+#include "penumbra/render/particles/particle_math.h"
 
 namespace penumbra {
 namespace {
@@ -45,7 +45,7 @@ struct Scratch {
 constexpr int kPenumbraRays = kLightPenumbraRays;
 
 // a light with an extent: a sphere lamp (radius > 0) or the sun's disc. its unshadowed light is
-// analytic (render/lamp_math.h) and its visibility shared over 5x5 pixels.
+// analytic (render/light/lamp_math.h) and its visibility shared over 5x5 pixels.
 bool IsExtendedLight(const PosedLight& l) {
   return HasLightExtent(l.type == Light::Type::kDirectional, l.cos_angular_radius, l.radius_m);
 }
@@ -130,7 +130,7 @@ Vec3Lanes ExtendedLightContribution(const ExtendedAxisLanes& a, const BsdfLanes&
 // towards j (the ratio estimator of Heitz et al. 2018 with the shadow term shared). a pixel whose
 // window holds both visible and occluded verdicts (a penumbra) traces more rays through its other
 // lattice points first, as many as the light's share of its unshadowed luminance asks for
-// (PenumbraLatticePoints, render/lamp_math.h: up to kPenumbraRays - 1 more, so that a window
+// (PenumbraLatticePoints, render/light/lamp_math.h: up to kPenumbraRays - 1 more, so that a window
 // there averages up to 64 points, not 16); a lamp's visible fraction is then averaged once more
 // over 3x3 pixels on the same surface. the windows are tested as bit masks (one 32-bit word per
 // tile row, EmbreeRenderer::kTileSize <= 28), and a window or 3x3 block whose verdicts agree
@@ -470,8 +470,8 @@ void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scra
 
 // what the effects do to the radiance L seen through pixel `pixel` along the camera ray:
 // the media along the ray attenuate and add to it, and the nearest particle streak is
-// alpha-composited over it (render/media_realtime.h, render/particle_streaks.h). no random
-// numbers here (the froxel volumes are jittered per column when they are built). `quad`: the
+// alpha-composited over it (render/media/media_realtime.h, render/particles/particle_streaks.h). no
+// random numbers here (the froxel volumes are jittered per column when they are built). `quad`: the
 // shared froxel lookups of the pixel's 2x2 quad, or null.
 Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool hit, float t_hit,
                                  int u, int v, Eigen::Vector3f L, const MediaQuad* quad) {
@@ -635,7 +635,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       }
     }
     if (!hit.any()) continue;
-    // the lattice point of every lane's pixel (render/lamp_math.h): where its shadow rays
+    // the lattice point of every lane's pixel (render/light/lamp_math.h): where its shadow rays
     // towards lights with an extent go. no random numbers.
     Lanes stratum_u1, stratum_u2;
     for (int k = 0; k < kLanes; ++k)

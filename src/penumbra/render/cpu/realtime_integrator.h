@@ -15,8 +15,8 @@
 //
 // point lights, spots without a radius and a sun without a disc: wi towards the light, V_i from
 // one shadow ray. lights with an extent (a lamp's sphere, radius_m > 0; the sun's disc,
-// angular radius > 0), render/lamp_math.h: E_i is the sphere's (or disc's) illuminance clipped
-// by the surface's horizon in closed form (Snyder 1996, SphereLightCosine), f taken at the
+// angular radius > 0), render/light/lamp_math.h: E_i is the sphere's (or disc's) illuminance
+// clipped by the surface's horizon in closed form (Snyder 1996, SphereLightCosine), f taken at the
 // direction to its centre (tilted above the horizon where it straddles it), and V_i the
 // fraction of visible shadow rays over the 5x5 pixels around the pixel on the same surface,
 // each pixel's ray going through its own point of a 16-point Fibonacci lattice over the
@@ -37,15 +37,15 @@
 // adverse conditions (FrameContext::effects): surface wetness changes the material of
 // upward-facing surfaces; each light's contribution is attenuated by the media between the
 // surface and the light; the pixel's radiance L (surface or sky) becomes T L + L_media along the
-// camera ray (render/media_realtime.h: closed-form fog, froxel volumes for grids and for fog
+// camera ray (render/media/media_realtime.h: closed-form fog, froxel volumes for grids and for fog
 // light in-scatter, isotropic unoccluded sky in-scatter), and the nearest particle streak is
-// alpha-composited over it (render/particle_streaks.h). without effects nothing changes.
+// alpha-composited over it (render/particles/particle_streaks.h). without effects nothing changes.
 //
 // speed: a tile row of kLanes (16) pixels is shaded at once as SIMD lanes (BsdfLanes,
 // LightSampler::SampleLanes) and its first shadow rays towards one light form one Embree packet
 // (RayScene::OccludedLanes); materials and textures are evaluated per pixel, textures filtered
-// over the pixel's ray cone (render/material_eval.h, Camera::pixel_spread_rad), by the renderer
-// before the tile is shaded (PrimaryHits::materials; a material's base, normal and
+// over the pixel's ray cone (render/material/material_eval.h, Camera::pixel_spread_rad), by the
+// renderer before the tile is shaded (PrimaryHits::materials; a material's base, normal and
 // metallic-roughness maps in one pass). the sky volume's probe weights are found once per 2x2
 // pixel quad that sees one flat face, at the quad's mean hit point and the face's geometric
 // normal (they vary over a probe spacing, tens of pixels), else per pixel; the resulting SH is

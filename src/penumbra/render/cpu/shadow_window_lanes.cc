@@ -2,7 +2,7 @@
 
 #include <vector>
 
-#include "penumbra/render/shadow_window_math.h"
+#include "penumbra/render/light/shadow_window_math.h"
 
 #if defined(__AVX512F__)
 #include <immintrin.h>

@@ -8,11 +8,11 @@
 #include <string>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/analytic_shapes.h"
 #include "penumbra/render/bvh/bvh_traversal.h"
+#include "penumbra/render/geometry/analytic_shapes.h"
+#include "penumbra/render/geometry/static_geometry.h"
+#include "penumbra/render/geometry/triangle_shapes.h"
 #include "penumbra/render/transport/primary_pixel.h"
-#include "penumbra/render/static_geometry.h"
-#include "penumbra/render/triangle_shapes.h"
 
 namespace penumbra::cuda {
 namespace {
@@ -77,7 +77,7 @@ void BvhScene::AddGeom(int gi, const Pose& X_IG, std::vector<PrimBox>* boxes, in
     const Eigen::Vector3f p = X_IG.translation().cast<float>();
     std::vector<Eigen::Vector3f> v_I(shape.vertices.size());
     for (size_t i = 0; i < v_I.size(); ++i) v_I[i] = R * shape.vertices[i] + p;
-    // vertex normals and texcoords as RayScene keeps them (render/triangle_shapes.h)
+    // vertex normals and texcoords as RayScene keeps them (render/geometry/triangle_shapes.h)
     const TriangleShadingTerms terms = ShadingTermsOf(shape, R);
     const bool normals = !terms.normals_I.empty(), uv = !shape.texcoords.empty();
     for (size_t f = 0; f < shape.faces.size(); ++f) {

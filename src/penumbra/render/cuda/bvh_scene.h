@@ -1,11 +1,11 @@
 #pragma once
 // the CUDA backend's scene on the host: the SceneDescription's traced geoms (those RayScene
 // traces: groups <= 2, material alpha >= 0.5) as the flat arrays of bvh_types.h. boxes,
-// meshes and height fields are triangles (render/triangle_shapes.h), planes, spheres, capsules,
-// ellipsoids and cylinders analytic (render/analytic_shapes.h), grouped as RayScene groups
-// them: the static bodies merged in the world frame, every moving body on its own. Update
-// rewrites the instances' transforms from a snapshot and rebuilds the top level over their world
-// boxes (a few hundred at most; the BLASes are built once, the static one again only if a
+// meshes and height fields are triangles (render/geometry/triangle_shapes.h), planes, spheres,
+// capsules, ellipsoids and cylinders analytic (render/geometry/analytic_shapes.h), grouped as
+// RayScene groups them: the static bodies merged in the world frame, every moving body on its own.
+// Update rewrites the instances' transforms from a snapshot and rebuilds the top level over their
+// world boxes (a few hundred at most; the BLASes are built once, the static one again only if a
 // static body moved, normally once, at the first Update). visible spatial
 // tendons (SceneDescription::tendons) are a last group in the world frame, as RayScene draws
 // them: a capsule of the tendon's width around each segment of the snapshot's wrap-point paths
@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "penumbra/core/pose.h"
-#include "penumbra/render/cuda/bvh_builder.h"
 #include "penumbra/render/bvh/bvh_types.h"
+#include "penumbra/render/cuda/bvh_builder.h"
 #include "penumbra/render/ray.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"

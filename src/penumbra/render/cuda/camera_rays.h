@@ -1,7 +1,7 @@
 #pragma once
 // the primary rays of a camera that is not a plain pinhole (lens distortion, a moving camera:
 // rolling shutter), for the CUDA backend: tables the host computes with the CPU backend's own
-// camera model (render/camera.h: Camera::Unproject undistorts, Camera::PoseAtRow gives each
+// camera model (render/camera/camera.h: Camera::Unproject undistorts, Camera::PoseAtRow gives each
 // row's pose) and PinholeCamera points to (PinholeCamera::xy, rows), so the kernels' PrimaryRay
 // (realtime_shading.h) casts the ray Camera::GenerateRay casts: o + t (x ex + y ey + ez) with
 // (x, y) the pixel's undistorted normalised coordinates and o, ex, ey, ez the optical centre
@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/renderer.h"
 

@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_renderer.h"

@@ -15,10 +15,10 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/exp_rn.h"
-#include "penumbra/render/analytic_shape_math.h"
 #include "penumbra/render/bvh/bvh_traversal.h"
 #include "penumbra/render/cuda/cuda_device_buffer.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/geometry/analytic_shape_math.h"
 #include "penumbra/render/transport/primary_pixel.h"
 #include "penumbra/render/transport/realtime.h"
 

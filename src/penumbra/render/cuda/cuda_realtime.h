@@ -9,7 +9,7 @@
 // hit's material terms (SurfaceTerms, for the shading kernel); with a mirror layer in the scene
 // it also traces the mirrored rays (TraceMirrorRay); (2) a kernel turns the geometry into sky
 // terms, one thread per 2x2 quad (QuadSkyTerms) and, with a mirror layer, one per mirrored ray
-// (MirrorSkyTerm): the shared lookups of render/sky_eval_math.h over the device copies of the
+// (MirrorSkyTerm): the shared lookups of render/sky/sky_eval_math.h over the device copies of the
 // SkyModel's and SkyIrradianceVolume's arrays (UploadSky), the functions the CPU backend calls;
 // (3) the shading kernel (ShadeRealtimeStored; small frames with their shadow rays through a
 // queue), the shared visibility's kernels (a warp's penumbra rays spread over its lanes, the
@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "penumbra/render/cuda/cuda_kernels.h"
-#include "penumbra/render/film_math.h"
+#include "penumbra/render/film/film_math.h"
 #include "penumbra/render/transport/realtime.h"
 
 namespace penumbra::cuda {
@@ -260,8 +260,8 @@ class DeviceRealtime : NonCopyable {
   /// @throws Error on a CUDA failure.
   bool DownloadGridVolumes(GridVolumeArrays* out) const;
   /// the realtime splat's per-pixel StreakKeys of the last Render (StreakSplatView::nearest,
-  /// width x height, row-major; render/particle_math.h's kNoStreakKey where no streak) copied
-  /// into *out (tests); false (*out untouched) if that frame splatted none.
+  /// width x height, row-major; render/particles/particle_math.h's kNoStreakKey where no streak)
+  /// copied into *out (tests); false (*out untouched) if that frame splatted none.
   /// @throws Error on a CUDA failure.
   bool DownloadStreakKeys(std::vector<unsigned long long>* out) const;
 

@@ -3,10 +3,10 @@
 #include <chrono>
 #include <cmath>
 
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
-#include "penumbra/render/emitter_sampler.h"
+#include "penumbra/render/light/emitter_sampler.h"
 #include "penumbra/scene/texture_image.h"
 
 namespace penumbra::cuda {

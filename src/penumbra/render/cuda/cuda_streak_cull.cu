@@ -14,7 +14,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/cuda/cuda_device_buffer.h"
 #include "penumbra/render/cuda/cuda_streak_cull.h"
-#include "penumbra/render/streak_cull_math.h"
+#include "penumbra/render/particles/streak_cull_math.h"
 
 namespace penumbra::cuda {
 

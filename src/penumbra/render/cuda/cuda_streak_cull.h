@@ -1,6 +1,6 @@
 #pragma once
 // the drops of a frame's particle sets culled on the device: one thread per drop
-// runs the CPU's per-drop decision (render/streak_cull_math.h's StreakCullDrop, which
+// runs the CPU's per-drop decision (render/particles/streak_cull_math.h's StreakCullDrop, which
 // ParticleStreaks::Build calls too) and an order-keeping compaction (cub::DeviceScan's exclusive
 // sum over the kept flags, no atomics) writes the drawn streaks in the host's (set, index)
 // order as StreakPods (a = the drop's position, b = its streak end, r = the widened radius,
@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "penumbra/render/cuda/cuda_kernels.h"
-#include "penumbra/render/streak_cull_math.h"
+#include "penumbra/render/particles/streak_cull_math.h"
 #include "penumbra/render/transport/path_streaks.h"
 
 namespace penumbra::cuda {

@@ -1,5 +1,5 @@
 #pragma once
-// the grid media's arrays (render/media_scene_math.h's MediaGridPod: densities and emission)
+// the grid media's arrays (render/media/media_scene_math.h's MediaGridPod: densities and emission)
 // copied to the device, for the pathtraced kernels (DevicePath::UploadMedia) and the
 // realtime tier's grid volume kernels (DeviceRealtime). includes the CUDA
 // runtime header (cuda_device_buffer.h): only .cu files include this.
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "penumbra/render/cuda/cuda_device_buffer.h"
-#include "penumbra/render/media_scene_math.h"
+#include "penumbra/render/media/media_scene_math.h"
 
 namespace penumbra::cuda {
 

@@ -3,8 +3,8 @@
 // path_kernels.cu on the device): which frames it takes, the frame's plain data (PathFrameView over
 // a prepared RealtimeFrameData: the same posed scene, materials, textures, lights and sky), and the
 // finish every pathtraced frame gets on the host, as the CPU backend's EmbreeRenderer gives it: the
-// a-trous denoiser (render/denoiser.h, guided by the albedo, normal and depth) when the settings
-// ask for it, then the film's auto exposure and development (render/film.h).
+// a-trous denoiser (render/film/denoiser.h, guided by the albedo, normal and depth) when the
+// settings ask for it, then the film's auto exposure and development (render/film/film.h).
 // RenderPathtracedOnHost runs the GPU path's per-pixel functions on the CPU over the host BVH
 // (tests; the parity check without a GPU). no CUDA runtime here.
 
@@ -15,8 +15,8 @@
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/path_buffers.h"
 #include "penumbra/render/cuda/realtime_frame.h"
-#include "penumbra/render/denoiser.h"
-#include "penumbra/render/emitter_sampler.h"
+#include "penumbra/render/film/denoiser.h"
+#include "penumbra/render/light/emitter_sampler.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/render/transport/path_trace.h"
 

@@ -12,7 +12,7 @@
 
 #include "penumbra/render/bvh/bvh_types.h"
 #include "penumbra/render/cuda/bvh_builder.h"
-#include "penumbra/render/particle_streaks.h"
+#include "penumbra/render/particles/particle_streaks.h"
 #include "penumbra/render/transport/path_streaks.h"
 
 namespace penumbra::cuda {

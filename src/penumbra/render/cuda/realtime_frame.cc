@@ -7,9 +7,9 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
-#include "penumbra/render/camera.h"
+#include "penumbra/render/camera/camera.h"
 #include "penumbra/render/cuda/bvh_ray_query.h"
-#include "penumbra/render/material_eval.h"
+#include "penumbra/render/material/material_eval.h"
 #include "penumbra/scene/texture_image.h"
 
 namespace penumbra::cuda {

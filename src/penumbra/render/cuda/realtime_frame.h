@@ -4,9 +4,9 @@
 // posed lights (LightSampler), the geoms' poses, the pinhole camera and the frame's random-number
 // key; the frame's effects (light scales and extra lights through
 // LightSampler::Update, the moved or scaled sky and the surface wetness through
-// render/effects_sky.h, as the CPU backend's MediaFrame), particles (rain, snow, sparks: the
-// drops culled on the host with the CPU's render/particle_streaks.h, the streaks then splatted,
-// shaded and drawn over each pixel by the frame itself, StreakSplatView) and media
+// render/sky/effects_sky.h, as the CPU backend's MediaFrame), particles (rain, snow, sparks: the
+// drops culled on the host with the CPU's render/particles/particle_streaks.h, the streaks then
+// splatted, shaded and drawn over each pixel by the frame itself, StreakSplatView) and media
 // (homogeneous and grids:
 // PrepareMedia, RealtimeMedia's layouts built on the host and its four volumes (the grids' light
 // volumes and froxels, the world light volume, the fog froxels) by the frame itself on the
@@ -14,10 +14,10 @@
 // the streaks seen through them); the sky model and sky volume (SkyData, for
 // DeviceRealtime::UploadSky) and, for the host path, the per-pixel sky terms from the primary rays'
 // geometry (QuadSkyTerms of render/transport/realtime_shading.h: the shared lookups of
-// render/sky_eval_math.h, which the device's sky kernel runs too) and those of the mirror layer's
-// reflected rays (MirrorSkyTerms); and the film's exposure and encoding table. RenderRealtimeOnHost
-// runs the GPU path's per-pixel functions on the CPU over the host BVH (tests; the parity check
-// without a GPU). no CUDA runtime here: this file builds on machines without nvcc.
+// render/sky/sky_eval_math.h, which the device's sky kernel runs too) and those of the mirror
+// layer's reflected rays (MirrorSkyTerms); and the film's exposure and encoding table.
+// RenderRealtimeOnHost runs the GPU path's per-pixel functions on the CPU over the host BVH (tests;
+// the parity check without a GPU). no CUDA runtime here: this file builds on machines without nvcc.
 
 #include <cstdint>
 #include <functional>
@@ -31,18 +31,18 @@
 #include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/path_streak_build.h"
-#include "penumbra/render/effects_sky.h"
-#include "penumbra/render/film.h"
-#include "penumbra/render/light_sampler.h"
-#include "penumbra/render/media_realtime.h"
-#include "penumbra/render/media_scene.h"
-#include "penumbra/render/particle_streaks.h"
+#include "penumbra/render/film/film.h"
+#include "penumbra/render/light/light_sampler.h"
+#include "penumbra/render/media/media_realtime.h"
+#include "penumbra/render/media/media_scene.h"
+#include "penumbra/render/particles/particle_streaks.h"
+#include "penumbra/render/particles/shelter_map.h"
 #include "penumbra/render/ray_query.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/render/shelter_map.h"
-#include "penumbra/render/sky_irradiance_volume.h"
-#include "penumbra/render/sky_model.h"
+#include "penumbra/render/sky/effects_sky.h"
+#include "penumbra/render/sky/sky_irradiance_volume.h"
+#include "penumbra/render/sky/sky_model.h"
 #include "penumbra/render/transport/realtime.h"
 
 namespace penumbra::cuda {

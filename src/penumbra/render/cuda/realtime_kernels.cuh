@@ -65,7 +65,7 @@ __device__ inline FramePixel PixelOf(const RealtimeFrameView& f, int row0 = 0, i
   return p;
 }
 
-// the blocks of the kernels that work a shadow tile (render/shadow_window_math.h) at a time:
+// the blocks of the kernels that work a shadow tile (render/light/shadow_window_math.h) at a time:
 // one thread a pixel of the tile (whose pixels' windows never leave it).
 constexpr int kTilePixels = kShadowTileSize * kShadowTileSize;
 inline dim3 TileBlock() { return dim3(kShadowTileSize, kShadowTileSize); }

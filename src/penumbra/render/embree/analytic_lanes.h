@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "penumbra/render/analytic_shapes.h"
+#include "penumbra/render/geometry/analytic_shapes.h"
 
 namespace penumbra {
 

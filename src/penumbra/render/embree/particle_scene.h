@@ -1,13 +1,13 @@
 #pragma once
-// the particles' streaks (render/particle_streaks.h) as an Embree scene, for the pathtraced
-// tier's jittered camera rays: every streak of the frame is one Embree round linear curve (a
-// capsule: cone segment with spherical ends) in this class's own RTCScene, built per frame (BVH
-// over all streaks). the realtime tier splats the same streaks per pixel instead
+// the particles' streaks (render/particles/particle_streaks.h) as an Embree scene, for the
+// pathtraced tier's jittered camera rays: every streak of the frame is one Embree round linear
+// curve (a capsule: cone segment with spherical ends) in this class's own RTCScene, built per frame
+// (BVH over all streaks). the realtime tier splats the same streaks per pixel instead
 // (ParticleStreaks::PixelHit) and builds no Embree scene.
 
 #include <memory>
 
-#include "penumbra/render/particle_streaks.h"
+#include "penumbra/render/particles/particle_streaks.h"
 #include "penumbra/render/ray.h"
 
 namespace penumbra {

@@ -9,13 +9,13 @@
 #include <string>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/analytic_shapes.h"
 #include "penumbra/render/embree/analytic_lanes.h"
-#include "penumbra/render/mesh_shading_math.h"
-#include "penumbra/render/moving_bounds.h"
-#include "penumbra/render/ray_cone.h"
-#include "penumbra/render/static_geometry.h"
-#include "penumbra/render/triangle_shapes.h"
+#include "penumbra/render/geometry/analytic_shapes.h"
+#include "penumbra/render/geometry/mesh_shading_math.h"
+#include "penumbra/render/geometry/moving_bounds.h"
+#include "penumbra/render/geometry/ray_cone.h"
+#include "penumbra/render/geometry/static_geometry.h"
+#include "penumbra/render/geometry/triangle_shapes.h"
 #include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {

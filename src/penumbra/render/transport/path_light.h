@@ -9,15 +9,15 @@
 
 #include "penumbra/core/host_device.h"
 #include "penumbra/core/rng.h"
-#include "penumbra/render/bsdf_math.h"
 #include "penumbra/render/bvh/bvh_traversal.h"
-#include "penumbra/render/emitter_math.h"
-#include "penumbra/render/light_math.h"
-#include "penumbra/render/media_scene_math.h"
-#include "penumbra/render/path_math.h"
+#include "penumbra/render/light/bsdf_math.h"
+#include "penumbra/render/light/emitter_math.h"
+#include "penumbra/render/light/light_math.h"
+#include "penumbra/render/light/path_math.h"
+#include "penumbra/render/media/media_scene_math.h"
 #include "penumbra/render/shading_math.h"
-#include "penumbra/render/sky_eval_math.h"
-#include "penumbra/render/sky_sampling_math.h"
+#include "penumbra/render/sky/sky_eval_math.h"
+#include "penumbra/render/sky/sky_sampling_math.h"
 #include "penumbra/render/transport/path_streaks.h"
 #include "penumbra/render/transport/scene_view.h"
 #include "penumbra/render/transport/surface.h"
@@ -30,10 +30,11 @@ constexpr int kPathRussianRouletteStartVertex = 3;
 /// shadow rays towards a point at distance d stop this fraction short of it (the CPU's).
 constexpr float kPathShadowShorten = 1e-4f;
 
-/// the scene's emissive geoms as the path samples them (EmitterSampler's, render/emitter_math.h):
-/// num emitters in pick order, their plain data, emitted radiance (cd/m^2) and pick cdf (num + 1
-/// values), per SceneDescription geom (num_geoms) its emitter or -1, and per emitter its geom's
-/// world pose for the frame, 12 doubles (rotation row-major, translation). num 0: none.
+/// the scene's emissive geoms as the path samples them (EmitterSampler's,
+/// render/light/emitter_math.h): num emitters in pick order, their plain data, emitted radiance
+/// (cd/m^2) and pick cdf (num + 1 values), per SceneDescription geom (num_geoms) its emitter or -1,
+/// and per emitter its geom's world pose for the frame, 12 doubles (rotation row-major,
+/// translation). num 0: none.
 struct PathEmitters {
   int32_t num = 0;
   const EmitterPod* pods = nullptr;

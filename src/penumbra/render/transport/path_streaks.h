@@ -2,21 +2,21 @@
 // the particle streaks (rain, snow, sparks) of a pathtraced frame as the path kernels trace
 // them, written once as PB_HOST_DEVICE functions over plain data: the GPU (path_kernels.cu) and
 // the host path (RenderPathtracedOnHost) run them. every streak is the capsule of the CPU's
-// ParticleStreaks (render/particle_streaks.h: the segment a particle sweeps in the exposure, its
-// widened radius), which the CPU backend traces as an Embree round linear curve
+// ParticleStreaks (render/particles/particle_streaks.h: the segment a particle sweeps in the
+// exposure, its widened radius), which the CPU backend traces as an Embree round linear curve
 // (render/embree/particle_scene.h); here a BVH over the capsules' boxes (built on the host per
 // frame by bvh_builder.h's binned SAH, path_streak_build.h) is traversed by the scene's own
-// traversal (TraverseWideBvh) with Quilez's ray-capsule test (render/particle_math.h's
+// traversal (TraverseWideBvh) with Quilez's ray-capsule test (render/particles/particle_math.h's
 // IntersectCapsule, which the realtime tier's splat calls too), and a hit streak is shaded by
 // ParticleStreaks::Shade's ShadeStreak. C++17, no Eigen: path_kernels.cu includes it.
 
 #include <cstdint>
 
 #include "penumbra/core/host_device.h"
-#include "penumbra/render/bsdf_math.h"
 #include "penumbra/render/bvh/bvh_traversal.h"
 #include "penumbra/render/bvh/bvh_types.h"
-#include "penumbra/render/particle_math.h"
+#include "penumbra/render/light/bsdf_math.h"
+#include "penumbra/render/particles/particle_math.h"
 #include "penumbra/render/shading_math.h"
 
 namespace penumbra::cuda {

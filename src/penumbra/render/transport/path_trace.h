@@ -44,9 +44,9 @@
 
 #include "penumbra/core/host_device.h"
 #include "penumbra/core/rng.h"
-#include "penumbra/render/bsdf_math.h"
 #include "penumbra/render/bvh/bvh_traversal.h"
-#include "penumbra/render/path_math.h"
+#include "penumbra/render/light/bsdf_math.h"
+#include "penumbra/render/light/path_math.h"
 #include "penumbra/render/transport/path_light.h"
 #include "penumbra/render/transport/path_streaks.h"
 #include "penumbra/render/transport/scene_view.h"

@@ -14,14 +14,14 @@
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/bvh/bvh_traversal.h"
 #include "penumbra/render/bvh/bvh_types.h"
-#include "penumbra/render/mesh_shading_math.h"
+#include "penumbra/render/geometry/mesh_shading_math.h"
 #include "penumbra/render/shading_math.h"
 
 namespace penumbra::cuda {
 
 /// a pinhole camera as the primary-ray kernel takes it: world ray through pixel (u, v) (pixel
 /// centres are integers) is o + t (((u - cx) inv_fx) ex + ((v - cy) inv_fy) ey + ez), as
-/// Camera::GenerateRay (render/camera.h) for a camera without distortion or motion.
+/// Camera::GenerateRay (render/camera/camera.h) for a camera without distortion or motion.
 struct PinholeCamera {
   F3 o, ex, ey, ez;
   float cx = 0, cy = 0, inv_fx = 1, inv_fy = 1;

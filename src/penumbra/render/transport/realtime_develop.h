@@ -1,11 +1,11 @@
 #pragma once
 // the realtime tier's film development per pixel: the log-luminance sums of the auto exposure
-// and the exposure, tone map and sRGB encoding of a pixel (render/film_math.h, as Film).
+// and the exposure, tone map and sRGB encoding of a pixel (render/film/film_math.h, as Film).
 
 #include <cstdint>
 
 #include "penumbra/core/host_device.h"
-#include "penumbra/render/film_math.h"
+#include "penumbra/render/film/film_math.h"
 #include "penumbra/render/transport/scene_view.h"
 
 namespace penumbra::cuda {

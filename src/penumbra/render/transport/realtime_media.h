@@ -1,5 +1,5 @@
 #pragma once
-// the realtime tier's homogeneous media (fog, haze, dust; render/media_realtime_math.h): the
+// the realtime tier's homogeneous media (fog, haze, dust; render/media/media_realtime_math.h): the
 // light volumes' cells with their shadow rays (MediaLightVolumeCell, MediaGridLightCell), the
 // view froxels' columns (MediaGridFroxelColumn, MediaFogColumn) and the view pass over each
 // pixel's radiance, with its streak (MediaViewQuad), as the CPU's RealtimeMedia.
@@ -8,8 +8,8 @@
 
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/bvh/bvh_traversal.h"
-#include "penumbra/render/media_build_math.h"
-#include "penumbra/render/media_realtime_math.h"
+#include "penumbra/render/media/media_build_math.h"
+#include "penumbra/render/media/media_realtime_math.h"
 #include "penumbra/render/transport/realtime_streaks.h"
 #include "penumbra/render/transport/scene_view.h"
 

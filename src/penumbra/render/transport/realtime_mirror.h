@@ -1,16 +1,16 @@
 #pragma once
 // the realtime tier's mirror layer (SurfaceMaterial::mirror, weight r: L becomes (1 - r) L +
 // r L_m) as render/cpu/mirror_layer.cc: the mirrored view ray traced on the layer's grid
-// (render/mirror_math.h; TraceMirrorRay), its hit shaded with one random sample of every light
-// and a shadow ray and the occluded sky irradiance at the hit (ShadeMirrorHit), the other layer
-// pixels interpolated from the grid and blended (ApplyMirrorLayer).
+// (render/light/mirror_math.h; TraceMirrorRay), its hit shaded with one random sample of every
+// light and a shadow ray and the occluded sky irradiance at the hit (ShadeMirrorHit), the other
+// layer pixels interpolated from the grid and blended (ApplyMirrorLayer).
 
 #include <cstdint>
 
 #include "penumbra/core/host_device.h"
 #include "penumbra/core/rng.h"
 #include "penumbra/render/bvh/bvh_traversal.h"
-#include "penumbra/render/mirror_math.h"
+#include "penumbra/render/light/mirror_math.h"
 #include "penumbra/render/transport/realtime_shading.h"
 #include "penumbra/render/transport/scene_view.h"
 #include "penumbra/render/transport/surface.h"
@@ -43,8 +43,8 @@ PB_HOST_DEVICE inline TraceRay MirrorRay(const RealtimeFrameView& f, int u, int 
 }
 
 /// the traced grid pixels whose reflected radiance pixel (u, v) of the mirror layer takes when
-/// it is off its layer's grid (render/mirror_math.h, as render/cpu/mirror_layer.cc): of the up
-/// to 4 grid pixels around it in its 16x16 tile (ShadowTileOf), those with a layer of the same
+/// it is off its layer's grid (render/light/mirror_math.h, as render/cpu/mirror_layer.cc): of the
+/// up to 4 grid pixels around it in its 16x16 tile (ShadowTileOf), those with a layer of the same
 /// grid step on the same flat face (same geom, equal geometric normal), in the CPU's order (v,
 /// then u); their pixel indices in idx and bilinear weights (MirrorGridWeight) in w. returns
 /// how many (0: the pixel traces its own ray).

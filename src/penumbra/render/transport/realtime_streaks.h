@@ -1,13 +1,13 @@
 #pragma once
 // the realtime tier's particle streaks (rain, snow, sparks): splatted per pixel by the frame
-// (SplatStreakRow, ShadeSplatPixel over render/particle_math.h's projection and capsule test,
-// as the CPU's ParticleStreaks::BuildPixelHits) or found in the host splat's list
+// (SplatStreakRow, ShadeSplatPixel over render/particles/particle_math.h's projection and capsule
+// test, as the CPU's ParticleStreaks::BuildPixelHits) or found in the host splat's list
 // (PixelStreakOf), drawn over the pixel's radiance by ApplyStreak (scene_view.h).
 
 #include <cstdint>
 
 #include "penumbra/core/host_device.h"
-#include "penumbra/render/particle_math.h"
+#include "penumbra/render/particles/particle_math.h"
 #include "penumbra/render/transport/realtime_shading.h"
 #include "penumbra/render/transport/scene_view.h"
 

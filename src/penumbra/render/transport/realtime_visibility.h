@@ -2,15 +2,15 @@
 // the realtime tier's shared visibility of lights with an extent (lamp spheres, the sun's disc):
 // each pixel's penumbra rays, the ratio estimator over its 5x5 same-surface window cut at the
 // 16x16 tiles' edges and the resolve into the pixel's radiance (SharedVisibilityRays, Fraction,
-// Resolve after ShadeRealtimePixel), as render/shadow_window_math.h and the CPU's
+// Resolve after ShadeRealtimePixel), as render/light/shadow_window_math.h and the CPU's
 // shadow_window_lanes.cc.
 
 #include <cstdint>
 
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/bvh/bvh_traversal.h"
-#include "penumbra/render/lamp_math.h"
-#include "penumbra/render/shadow_window_math.h"
+#include "penumbra/render/light/lamp_math.h"
+#include "penumbra/render/light/shadow_window_math.h"
 #include "penumbra/render/transport/realtime_shading.h"
 #include "penumbra/render/transport/scene_view.h"
 
@@ -139,7 +139,7 @@ struct StridedWindowVerdicts {
 };
 
 /// a light's verdicts of a shadow tile as bit rows (kShadowVerdictRows words,
-/// render/shadow_window_math.h; the GPU's VisibilityRaysWarpKernel keeps them in shared
+/// render/light/shadow_window_math.h; the GPU's VisibilityRaysWarpKernel keeps them in shared
 /// memory) around tile pixel (x, y): the same values as StridedWindowVerdicts over the
 /// frame's f.area_vis.
 struct RowWindowVerdicts {
@@ -158,7 +158,7 @@ struct RowWindowVerdicts {
 /// whose window mask is `bits` (SharedVisibilityWindow). inactive (active 0) where the pixel
 /// traced no verdict towards j or j has no extent; where the verdicts in the window disagree (a
 /// penumbra), as many rays as the light's share of the pixel's unshadowed luminance asks for
-/// (PenumbraLatticePoints, render/lamp_math.h, as the CPU's ResolveSharedVisibility): on a
+/// (PenumbraLatticePoints, render/light/lamp_math.h, as the CPU's ResolveSharedVisibility): on a
 /// tile's outer ring the pixel's own points - 1 more (f.area_own set: that pixel keeps its own
 /// fraction), else max(1, points / kLightStrata) - 1 more after its first. writes f.area_own.
 /// the window's verdicts of light j come from `w` (Own, Seen): StridedWindowVerdicts over the

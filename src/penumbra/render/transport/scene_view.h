@@ -8,14 +8,14 @@
 #include <cstdint>
 
 #include "penumbra/core/host_device.h"
-#include "penumbra/render/film_math.h"
-#include "penumbra/render/light_math.h"
-#include "penumbra/render/media_build_math.h"
-#include "penumbra/render/media_realtime_math.h"
-#include "penumbra/render/particle_math.h"
+#include "penumbra/render/film/film_math.h"
+#include "penumbra/render/light/light_math.h"
+#include "penumbra/render/material/texture_math.h"
+#include "penumbra/render/media/media_build_math.h"
+#include "penumbra/render/media/media_realtime_math.h"
+#include "penumbra/render/particles/particle_math.h"
 #include "penumbra/render/shading_math.h"
-#include "penumbra/render/sky_eval_math.h"
-#include "penumbra/render/texture_math.h"
+#include "penumbra/render/sky/sky_eval_math.h"
 #include "penumbra/render/transport/path_streaks.h"
 #include "penumbra/render/transport/primary_pixel.h"
 
@@ -37,7 +37,8 @@ struct MaterialPod {
   int32_t texture = -1;  ///< into the frame's textures: a 2d texture, planar-mapped; -1 none
   float texrepeat[2] = {1, 1};
   int32_t texuniform = 0;
-  /// the PBR maps (render/material_eval.h, "PBR maps"), into the frame's textures; -1 none.
+  /// the PBR maps (render/material/material_eval.h, "PBR maps"), into the frame's textures; -1
+  /// none.
   int32_t normal_map = -1, metallic_roughness_map = -1, occlusion_map = -1, emissive_map = -1;
   /// the mirror layer's weight on a plane or a box's top face: min(reflectance, 1), 0 none
   /// (MaterialEvaluator::Untextured's SurfaceMaterial::mirror).
@@ -92,8 +93,8 @@ struct StreakPixel {
 };
 
 /// the realtime tier's particle streaks splatted per pixel by the frame itself
-/// (render/particle_math.h's ProjectStreak, StreakRowColumns and IntersectCapsuleRay, which the
-/// CPU backend's ParticleStreaks::BuildPixelHits calls too): every streak's pixel box is
+/// (render/particles/particle_math.h's ProjectStreak, StreakRowColumns and IntersectCapsuleRay,
+/// which the CPU backend's ParticleStreaks::BuildPixelHits calls too): every streak's pixel box is
 /// scanned, each pixel-centre ray (PrimaryRay) met by the capsule keeps the smallest StreakKey
 /// (nearest t, then lower index: the host splat's rule) in `nearest`, and each pixel with a key
 /// is shaded into `pixels` (ShadeSplatPixel).
@@ -152,19 +153,18 @@ struct RealtimeFrameView {
   /// per pixel: E_sky on the surface the pixel's ray hits, or the sky radiance where it
   /// escapes (QuadSkyTerms).
   const Float3* sky_term = nullptr;
-  /// the sky and the occluded sky volume (render/sky_eval_math.h) whose lookups make the sky
+  /// the sky and the occluded sky volume (render/sky/sky_eval_math.h) whose lookups make the sky
   /// terms (QuadSkyTerms, MirrorSkyTerm): device copies in the kernels, host arrays on the host.
   SkyModelPod sky;
   SkyVolumePod volume;
-  /// the shared visibility of lights with an extent (render/shadow_window_math.h), per pixel i
-  /// of the n = width x height image: its primary geometry (PrimaryGeometry) and its 5x5
-  /// window's same-surface mask (SharedVisibilityRays), the luminance of its radiance with
-  /// every light unshadowed (ShadeRealtimePixel; decides the penumbra ray budget,
-  /// PenumbraLatticePoints); per light j and pixel i at [j n + i]:
-  /// the unshadowed contribution and the pixel's own shadow ray's verdict (1 visible,
-  /// 0 occluded, -1 none traced; ShadeRealtimePixel), the visible and traced rays after the
-  /// penumbra rays, whether the pixel keeps its own fraction (a tile's outer ring), and the
-  /// window's fraction (SharedVisibilityFraction). device or host arrays the caller owns.
+  /// the shared visibility of lights with an extent (render/light/shadow_window_math.h), per pixel
+  /// i of the n = width x height image: its primary geometry (PrimaryGeometry) and its 5x5 window's
+  /// same-surface mask (SharedVisibilityRays), the luminance of its radiance with every light
+  /// unshadowed (ShadeRealtimePixel; decides the penumbra ray budget, PenumbraLatticePoints); per
+  /// light j and pixel i at [j n + i]: the unshadowed contribution and the pixel's own shadow ray's
+  /// verdict (1 visible, 0 occluded, -1 none traced; ShadeRealtimePixel), the visible and traced
+  /// rays after the penumbra rays, whether the pixel keeps its own fraction (a tile's outer ring),
+  /// and the window's fraction (SharedVisibilityFraction). device or host arrays the caller owns.
   const PixelGeometry* geometry = nullptr;
   uint32_t* window = nullptr;
   float* total = nullptr;
@@ -190,7 +190,7 @@ struct RealtimeFrameView {
   /// the frame's particle streaks for the splat the frame makes itself (streaks.num 0: none).
   StreakSplatView splat;
   /// the frame's homogeneous media (fog, haze, dust; has_media 1), their arrays as device or
-  /// host pointers (render/media_realtime_math.h, RealtimeMedia::HostView): the light
+  /// host pointers (render/media/media_realtime_math.h, RealtimeMedia::HostView): the light
   /// transmittances of the surface loop (ShadeRealtimePoint) and the view pass (MediaViewQuad).
   int32_t has_media = 0;
   RealtimeMediaView media;

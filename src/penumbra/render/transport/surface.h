@@ -2,15 +2,15 @@
 // the surface at a hit as the transport shades it: the material with its textures filtered over
 // the ray's cone (planar and cube mapping, trilinear and anisotropic mip filtering: FilterPlanar,
 // FilterCube), the PBR maps, the mirror layer's weight and the surface wetness (EvaluateSurface),
-// as the CPU's MaterialEvaluator (render/material_eval.h).
+// as the CPU's MaterialEvaluator (render/material/material_eval.h).
 
 #include <cstdint>
 
 #include "penumbra/core/host_device.h"
-#include "penumbra/render/brdf_math.h"
-#include "penumbra/render/texture_math.h"
+#include "penumbra/render/light/brdf_math.h"
+#include "penumbra/render/material/texture_math.h"
+#include "penumbra/render/material/wetness_math.h"
 #include "penumbra/render/transport/scene_view.h"
-#include "penumbra/render/wetness_math.h"
 
 namespace penumbra::cuda {
 
@@ -259,8 +259,8 @@ PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, c
         ns = bent;
     }
   }
-  // rain wetness (render/wetness_math.h) at the (bent) shading normal, after the PBR maps: the
-  // CPU's ApplySurfaceWetness at SurfaceHit::ns_W, in its primary shading and mirror layer.
+  // rain wetness (render/material/wetness_math.h) at the (bent) shading normal, after the PBR maps:
+  // the CPU's ApplySurfaceWetness at SurfaceHit::ns_W, in its primary shading and mirror layer.
   float wet_scale, wet_roughness;
   if (f.wetness > 0 &&
       SurfaceWetnessTerms(f.wetness, ns.z, sp.metallic, sp.roughness, &wet_scale, &wet_roughness)) {
