@@ -35,6 +35,7 @@ pkgs=(
   cyclonedds-dev cyclonedds-tools  # ROS 2 bridge and rosbag2 export: Cyclone DDS's C library and idlc
   python3-venv  # the project venv below
   iproute2  # tests/ros/ros2_remote_test.py: a second host as a network namespace
+  libllvm19  # Mitsuba 3's llvm_ad_rgb variant (Dr.Jit's LLVM backend; bookworm's LLVM 15 cannot select its fminimum)
 )
 missing=()
 for p in "${pkgs[@]}"; do
