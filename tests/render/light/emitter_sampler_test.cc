@@ -4,13 +4,12 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <numbers>
 
 #include "penumbra/core/rng.h"
 
 namespace penumbra {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // a scene with one body (the world) and the given emissive geoms (material 0 emits).
 SceneDescription SceneWith(const std::vector<Geom>& geoms, const Eigen::Vector3f& le) {
@@ -80,7 +79,7 @@ TEST(EmitterSamplerTest, SphereConeSamplingGivesExactIrradiance) {
   const std::vector<Pose> X_WB = {Pose::Identity()};
   const Eigen::Vector3d e = EstimateIrradiance(es, X_WB, {0, 0, 0}, {0, 0, 1}, 20000);
   for (int k = 0; k < 3; ++k) {
-    const double ref = 100.0 * (k + 1) * kPi * 0.3 * 0.3 / 4.0;
+    const double ref = 100.0 * (k + 1) * std::numbers::pi * 0.3 * 0.3 / 4.0;
     EXPECT_NEAR(e[k], ref, 0.005 * ref);
   }
 }
@@ -161,8 +160,8 @@ TEST(EmitterSamplerTest, CylinderAndCapsuleAreasAndPicking) {
       Eigen::Vector3f::Constant(1));
   const EmitterSampler es(scene);
   ASSERT_EQ(es.size(), 2);  // ellipsoids are not sampled
-  const double a_cyl = 4 * kPi * 0.1 * 0.2 + 2 * kPi * 0.01;
-  const double a_cap = 4 * kPi * 0.1 * 0.2 + 4 * kPi * 0.01;
+  const double a_cyl = 4 * std::numbers::pi * 0.1 * 0.2 + 2 * std::numbers::pi * 0.01;
+  const double a_cap = 4 * std::numbers::pi * 0.1 * 0.2 + 4 * std::numbers::pi * 0.01;
   Rng rng(HashKeys(9, 9));
   int cyl = 0;
   const int count = 100000;
