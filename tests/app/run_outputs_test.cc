@@ -182,7 +182,7 @@ TEST_F(RunOutputsTest, ASecondSignalExitsAtOnce) {
 }
 
 // a pathtraced frame of 4096 samples per pixel takes minutes; a single SIGINT / SIGTERM stops
-// it between samples (render/cpu/path_integrator.h): the run exits 130 / 143 soon after (30 s is
+// it between samples (render/cpu/path_tiles.h): the run exits 130 / 143 soon after (30 s is
 // far more than one sample pass of 64 x 48 pixels), writing run.json and the frames finished
 // before, and dropping the unfinished one
 void PathtracedFrameStopsWithinOnePass(const std::string& world, const fs::path& out, int sig,

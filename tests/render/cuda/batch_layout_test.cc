@@ -19,7 +19,7 @@
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/camera/camera.h"
-#include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/frame/bvh_scene.h"
 #include "penumbra/render/transport/primary_pixel.h"
 #include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"

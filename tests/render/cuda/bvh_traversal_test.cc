@@ -20,9 +20,9 @@
 #include <vector>
 
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/cuda/bvh_builder.h"
-#include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/embree/ray_scene.h"
+#include "penumbra/render/frame/bvh_builder.h"
+#include "penumbra/render/frame/bvh_ray_query.h"
 #include "penumbra/render/geometry/static_geometry.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"

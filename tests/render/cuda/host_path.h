@@ -4,8 +4,8 @@
 // (realtime_effects_test.cc, realtime_media_test.cc). no GPU needed.
 
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/cuda/bvh_scene.h"
-#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/cuda/realtime_host.h"
+#include "penumbra/render/frame/bvh_scene.h"
 #include "penumbra/render/ray_query.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/renderer.h"

@@ -14,7 +14,7 @@
 #include <cstdio>
 #include <memory>
 
-#include "penumbra/render/cuda/bvh_ray_query.h"
+#include "penumbra/render/frame/bvh_ray_query.h"
 
 namespace penumbra {
 namespace {

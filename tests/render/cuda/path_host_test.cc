@@ -1,10 +1,11 @@
-// the CUDA backend's pathtraced tier, run on the CPU (TracePathtracedOnHost: the very
-// PB_HOST_DEVICE per-pixel functions the path kernel runs, over the host BVH), against the CPU
-// backend's PathIntegrator on the bundled default and house worlds (lamp spheres, the sun disc
-// through the window, the daylight sky) at 64x48 and 16 samples per pixel, no denoiser: the
-// radiance's mean relative difference at the scale of 8x8 blocks (path_parity.h) within
-// kHostTileTolerance, and two renders bit-identical. dropping the sky or the lights from the GPU
-// path moves it far beyond that (the metric can fail). no GPU needed.
+// the pathtraced tier's one chain (render/transport/path_trace.h) traced over the GPU's ray
+// tracer on the CPU (TraceOverBvh: PathTracePixel with BvhTracer, the host BVH), against the CPU
+// backend (the same chain over Embree, render/cpu/path_tiles.h) on the bundled default and house
+// worlds (lamp spheres, the sun disc through the window, the daylight sky) at 64x48 and 16
+// samples per pixel, no denoiser: the radiance's mean relative difference at the scale of 8x8
+// blocks (path_parity.h) within kHostTileTolerance, and two renders bit-identical: the tracer
+// seam alone. dropping the sky or the lights from the frame moves it far beyond that (the metric
+// can fail). no GPU needed.
 
 #include <gtest/gtest.h>
 
@@ -18,26 +19,44 @@
 
 #include "path_parity.h"
 #include "penumbra/core/rng.h"
+#include "penumbra/core/thread_pool.h"
 #include "penumbra/render/backends/renderer_factory.h"
+#include "penumbra/render/bvh/bvh_traversal.h"
 #include "penumbra/render/camera/camera.h"
-#include "penumbra/render/cuda/bvh_scene.h"
-#include "penumbra/render/cuda/camera_rays.h"
-#include "penumbra/render/cuda/path_frame.h"
+#include "penumbra/render/frame/bvh_scene.h"
+#include "penumbra/render/frame/camera_rays.h"
+#include "penumbra/render/frame/path_frame.h"
 #include "penumbra/render/light/emitter_sampler.h"
 #include "penumbra/render/media/media_scene.h"
 #include "penumbra/render/particles/particle_math.h"
 #include "penumbra/render/transport/path_streaks.h"
+#include "penumbra/render/transport/path_trace.h"
 #include "realtime_parity.h"
 
 namespace penumbra {
 namespace {
 
-// the host path shares the CPU's random streams and (without fused multiply-adds) its rounding
-// of every shared formula, so it tracks the CPU's estimate closely: what differs is where the BVH
-// and Embree round a hit's distance and normal, after which a path may branch differently.
-// measured: default 0.0000 %, house 0.23 % (without the sky 18.6 % and 88.2 %, without the
-// lights 81.4 % and 16.8 %): the bound is 1 %.
+// the two tracers feed the one chain with the CPU's random streams and rounding: what differs
+// is where the BVH and Embree round a hit's distance and barycentrics, after which a path may
+// branch differently. the bound is 1 % (docs/journal/2026-11-29-path-cpu.md).
 constexpr double kHostTileTolerance = 0.01;
+
+// the paths of frame `pf` (host arrays) traced over the host BVH (BvhTracer, as the GPU traces
+// them), rows over `pool`, into *out.
+void TraceOverBvh(const cuda::PathFrameView& frame, ThreadPool* pool, cuda::PathBuffers* out) {
+  const int W = frame.rt.camera.width, H = frame.rt.camera.height;
+  out->Resize(static_cast<int64_t>(W) * H);
+  cuda::PathFrameView pf = frame;
+  pf.radiance = out->radiance.data();
+  pf.albedo = out->albedo.data();
+  pf.normal = out->normal.data();
+  pf.depth = out->depth.data();
+  const auto go_on = [] { return false; };
+  ParallelForOrSerial(pool, H, [&](int64_t v) {
+    for (int u = 0; u < W; ++u)
+      cuda::PathTracePixel(pf, cuda::BvhTracer{pf.rt.scene}, u, static_cast<int>(v), go_on);
+  });
+}
 
 struct HostPathtraced {
   RenderedFrame want;
@@ -66,14 +85,14 @@ HostPathtraced RenderBoth(const std::string& world, bool distorted = false) {
   data.Prepare(snap, view, &pool);
   const cuda::PathFrameView pf =
       cuda::PathView(data, data.View(bvh.view(), nullptr), data.frame_sky().sampling_pod());
-  cuda::TracePathtracedOnHost(pf, &pool, &r.got);
-  cuda::TracePathtracedOnHost(pf, &pool, &r.again);
+  TraceOverBvh(pf, &pool, &r.got);
+  TraceOverBvh(pf, &pool, &r.again);
   cuda::PathFrameView dropped = pf;
   dropped.sky_active = 0;
-  cuda::TracePathtracedOnHost(dropped, &pool, &r.no_sky);
+  TraceOverBvh(dropped, &pool, &r.no_sky);
   dropped = pf;
   dropped.rt.num_lights = 0;
-  cuda::TracePathtracedOnHost(dropped, &pool, &r.no_lights);
+  TraceOverBvh(dropped, &pool, &r.no_lights);
   return r;
 }
 
@@ -233,11 +252,11 @@ void PrepareEffectsPath(const MediaFrameCase& c, ThreadPool* pool, EffectsPathFr
 
 // the GPU path with media (TracePath<true>: the free flights' delta tracking, the phase
 // function's next events and samples, the media's transmittance on every shadow ray; the shared
-// formulas of render/media/media_scene_math.h), run on the CPU, against the CPU backend's
-// PathIntegrator: fog (homogeneous; the rover's camera) and smoke_plume (a grid; the overview
-// camera, which sees the plume), 64x48, 16 spp. the paths draw the CPU's random numbers, so
-// they track its estimate closely; without the media (the paths of clear air) the difference
-// is far larger (the metric can fail).
+// formulas of render/media/media_scene_math.h), run on the CPU over the BVH, against the CPU
+// backend (the chain over Embree): fog (homogeneous; the rover's camera) and smoke_plume (a grid;
+// the overview camera, which sees the plume), 64x48, 16 spp. the paths draw the CPU's random
+// numbers, so they track its estimate closely; without the media (the paths of clear air) the
+// difference is far larger (the metric can fail).
 class PathtracedHostMedia : public ::testing::TestWithParam<std::pair<std::string, int>> {};
 
 TEST_P(PathtracedHostMedia, TracksTheCpuBackendsEstimate) {
@@ -253,10 +272,10 @@ TEST_P(PathtracedHostMedia, TracksTheCpuBackendsEstimate) {
   const MediaScene& media = e.media;
   cuda::PathFrameView pf = e.pf;
   cuda::PathBuffers got, again, clear;
-  cuda::TracePathtracedOnHost(pf, &pool, &got);
-  cuda::TracePathtracedOnHost(pf, &pool, &again);
+  TraceOverBvh(pf, &pool, &got);
+  TraceOverBvh(pf, &pool, &again);
   pf.media = MediaSceneView();
-  cuda::TracePathtracedOnHost(pf, &pool, &clear);
+  TraceOverBvh(pf, &pool, &clear);
   const double tile = path_parity::TileRelativeDifference(RadianceOf(got, 64, 48), want.radiance);
   const double mean = path_parity::MeanRelativeDifference(RadianceOf(got, 64, 48), want.radiance);
   const double tile_clear =
@@ -278,8 +297,8 @@ INSTANTIATE_TEST_SUITE_P(Effects, PathtracedHostMedia,
 
 // the GPU path with particles (TracePath<..., true>: a camera ray that meets a streak of the
 // frame's BVH (path_streaks.h) stops there with probability alpha, one draw, before the media's
-// free flight, and adds the streak's radiance, ShadeStreak), run on the CPU, against the CPU
-// backend's PathIntegrator (Embree's round curves): rain and snow (the rover's camera) and fire
+// free flight, and adds the streak's radiance, ShadeStreak), run on the CPU over the BVH, against
+// the CPU backend (the chain over Embree): rain and snow (the rover's camera) and fire
 // (sparks over a fire grid: TracePath<true, true>; the overview camera) at 1 s, 64x48, 16 spp.
 // the paths draw the CPU's random numbers, so the estimates agree closely; the same paths without
 // the streaks differ by far more (the metric can fail). the streaks' BVH is checked against a
@@ -287,9 +306,9 @@ INSTANTIATE_TEST_SUITE_P(Effects, PathtracedHostMedia,
 // host build time is printed.
 // the streaks change these 64x48 frames by 0.23 % (fire's few sparks) to 0.80 % (snow) at the
 // block scale, below the 1 % of the GPU tests: the tolerance here is the host path's own, 0.05 %
-// (measured 0.003 % to 0.007 %: the host path rounds as the CPU and draws its random numbers, so
-// only where Embree's round curves and the capsule test, or Embree and the BVH, round a hit apart
-// do the paths differ), which the same paths without the streaks exceed four times over.
+// (both trace the streaks with the capsule BVH and draw the same random numbers, so only where
+// Embree and the BVH round a surface hit apart do the paths differ), which the same paths
+// without the streaks exceed four times over.
 constexpr double kHostParticleTolerance = 0.0005;
 
 class PathtracedHostParticles : public ::testing::TestWithParam<std::pair<std::string, int>> {};
@@ -310,10 +329,10 @@ TEST_P(PathtracedHostParticles, TracksTheCpuBackendsEstimate) {
   cuda::PathFrameView pf = e.pf;
   pf.streaks = streaks;
   cuda::PathBuffers got, again, clear;
-  cuda::TracePathtracedOnHost(pf, &pool, &got);
-  cuda::TracePathtracedOnHost(pf, &pool, &again);
+  TraceOverBvh(pf, &pool, &got);
+  TraceOverBvh(pf, &pool, &again);
   pf.streaks = cuda::PathStreaks();
-  cuda::TracePathtracedOnHost(pf, &pool, &clear);
+  TraceOverBvh(pf, &pool, &clear);
   const double tile = path_parity::TileRelativeDifference(RadianceOf(got, 64, 48), want.radiance);
   const double mean = path_parity::MeanRelativeDifference(RadianceOf(got, 64, 48), want.radiance);
   const double tile_clear =

@@ -26,9 +26,9 @@
 
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cpu/embree_renderer.h"
-#include "penumbra/render/cuda/bvh_scene.h"
-#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/cuda/realtime_host.h"
 #include "penumbra/render/film/film_math.h"
+#include "penumbra/render/frame/bvh_scene.h"
 #include "realtime_parity.h"
 
 namespace penumbra {

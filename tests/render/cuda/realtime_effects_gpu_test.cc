@@ -25,10 +25,10 @@
 
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
-#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/cuda/realtime_host.h"
+#include "penumbra/render/frame/bvh_scene.h"
 #include "penumbra/render/particles/particle_math.h"
 #include "realtime_parity.h"
 

@@ -5,6 +5,8 @@
 // >= 40 dB (the `gpu` test RealtimeRgbGpu checks it at 640x480 on the GPU)
 // and depth within 1 mm on >= 99.9 % of pixels; two renders are bit-identical. no GPU needed.
 
+#include "penumbra/render/cuda/realtime_host.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -19,8 +21,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/camera/camera.h"
-#include "penumbra/render/cuda/bvh_scene.h"
-#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/frame/bvh_scene.h"
 #include "realtime_parity.h"
 #include "render/render_test_util.h"
 

@@ -24,10 +24,10 @@
 
 #include "host_path.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/render/cuda/bvh_ray_query.h"
-#include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
-#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/cuda/realtime_host.h"
+#include "penumbra/render/frame/bvh_ray_query.h"
+#include "penumbra/render/frame/bvh_scene.h"
 #include "realtime_parity.h"
 
 namespace penumbra {

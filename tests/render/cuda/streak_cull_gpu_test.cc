@@ -25,7 +25,7 @@
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
 #include "penumbra/render/cuda/cuda_streak_cull.h"
-#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/frame/realtime_frame.h"
 #include "realtime_parity.h"
 
 namespace penumbra {

@@ -29,7 +29,7 @@
 
 #include "host_path.h"
 #include "penumbra/render/camera/camera.h"
-#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/cuda/realtime_host.h"
 #include "penumbra/render/particles/streak_cull_math.h"
 #include "realtime_parity.h"
 

@@ -19,10 +19,10 @@
 
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/camera/camera.h"
-#include "penumbra/render/cuda/bvh_ray_query.h"
-#include "penumbra/render/cuda/bvh_scene.h"
-#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/cuda/realtime_host.h"
 #include "penumbra/render/embree/ray_scene.h"
+#include "penumbra/render/frame/bvh_ray_query.h"
+#include "penumbra/render/frame/bvh_scene.h"
 #include "penumbra/render/material/material_eval.h"
 #include "penumbra/render/sky/sky_model.h"
 #include "realtime_parity.h"

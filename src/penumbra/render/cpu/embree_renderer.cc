@@ -8,21 +8,21 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera/camera_ground_truth.h"
-#include "penumbra/render/cpu/path_integrator.h"
+#include "penumbra/render/cpu/path_tiles.h"
 #include "penumbra/render/cpu/realtime_integrator.h"
 #include "penumbra/render/geometry/ray_cone.h"
 
 namespace penumbra {
 namespace {
 
-// the integrator of a tier: the one place that maps tiers to light-transport algorithms.
-std::unique_ptr<Integrator> MakeIntegrator(const RenderSettings& settings,
-                                           const SceneDescription& scene) {
+// the realtime tier's integrator (the pathtraced tier runs the transport's path chain:
+// PathTiles).
+std::unique_ptr<Integrator> MakeIntegrator(const RenderSettings& settings) {
   switch (settings.tier) {
     case RenderSettings::Tier::kRealtime:
       return std::make_unique<RealtimeIntegrator>();
     case RenderSettings::Tier::kPathtraced:
-      return std::make_unique<PathIntegrator>(scene);
+      return nullptr;
   }
   throw Error("unknown render tier");
 }
@@ -45,9 +45,11 @@ EmbreeRenderer::EmbreeRenderer(const SceneDescription& scene, const RenderSettin
       sky_volume_(RaySceneFactory()),
       film_(settings_),
       pool_(settings_.threads),
-      integrator_(MakeIntegrator(settings_, scene_)) {
-  if (settings_.tier == RenderSettings::Tier::kPathtraced && settings_.denoise)
-    denoiser_ = std::make_unique<Denoiser>();
+      integrator_(MakeIntegrator(settings_)) {
+  if (settings_.tier == RenderSettings::Tier::kPathtraced) {
+    path_ = std::make_unique<PathTiles>(scene_, settings_, &pool_);
+    if (settings_.denoise) denoiser_ = std::make_unique<Denoiser>();
+  }
 }
 
 void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* effects,
@@ -63,11 +65,17 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
     }
     materials_.SetGeomRotations(std::move(R_WG));
   }
-  lights_.Update(snapshot, effects);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
-  // adverse conditions (media, particles, sky and light changes): render/cpu/media_frame.h.
-  effects_.Prepare(snapshot, effects, camera, view, settings_, lights_, *ray_scene_, sky_,
-                   &sky_volume_, &pool_);
+  const CameraOutputs& want = view.outputs;
+  // the pathtraced tier: the path chain's frame data (its own lights, sky, media and streaks)
+  const bool paths = path_ != nullptr && want[ImageKind::kRgb];
+  if (paths) path_->Prepare(snapshot, effects, view, &pool_);
+  if (!path_) {
+    lights_.Update(snapshot, effects);
+    // adverse conditions (media, particles, sky and light changes): render/cpu/media_frame.h.
+    effects_.Prepare(snapshot, effects, camera, view, settings_, lights_, *ray_scene_, sky_,
+                     &sky_volume_, &pool_);
+  }
   // realtime tier: sky light occluded by the static geometry, rebuilt only when the static
   // bodies move and relit when the sky changes (render/sky/sky_irradiance_volume.h).
   if (settings_.tier == RenderSettings::Tier::kRealtime)
@@ -78,8 +86,6 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
       settings_.tier == RenderSettings::Tier::kRealtime && ablation_.sun_occluder;
   if (use_sun_occluders) sun_occluders_.Update(scene_, snapshot, lights_, &pool_);
   const int W = camera.width(), H = camera.height();
-  const CameraOutputs& want = view.outputs;
-  const bool denoise = want[ImageKind::kRgb] && denoiser_ != nullptr;
 
   if (want[ImageKind::kRgb]) {
     Reshape(&out->radiance, W, H, 3);
@@ -93,10 +99,6 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
     depth = &out->depth_m;
   } else {
     out->depth_m = ImageF();
-    if (denoise) {
-      Reshape(&depth_, W, H, 1);
-      depth = &depth_;
-    }
   }
   if (want[ImageKind::kSegmentation]) {
     Reshape(&out->geom_id, W, H, 1);
@@ -105,26 +107,18 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   }
   const GroundTruthImages truth = PrepareGroundTruth(want, W, H, out);
   FrameBuffers buffers;
-  if (want[ImageKind::kRgb]) {
-    buffers.radiance = &out->radiance;
-    if (denoise) {
-      Reshape(&albedo_, W, H, 3);
-      Reshape(&normal_, W, H, 3);
-      buffers.albedo = &albedo_;
-      buffers.normal = &normal_;
-    }
-  }
+  if (want[ImageKind::kRgb]) buffers.radiance = &out->radiance;
 
   FrameContext ctx;
   ctx.scene = ray_scene_.get();
   ctx.materials = &materials_;
   ctx.lights = &lights_;
-  ctx.sky = effects_.sky();
-  if (settings_.tier == RenderSettings::Tier::kRealtime && !sky_volume_.empty() &&
-      ablation_.sky_volume)
-    ctx.sky_volume = &sky_volume_;
+  if (!path_) {
+    ctx.sky = effects_.sky();
+    if (!sky_volume_.empty() && ablation_.sky_volume) ctx.sky_volume = &sky_volume_;
+    ctx.effects = effects_.active() ? &effects_ : nullptr;
+  }
   if (use_sun_occluders && !sun_occluders_.empty()) ctx.sun_occluders = &sun_occluders_;
-  ctx.effects = effects_.active() ? &effects_ : nullptr;
   ctx.camera = &camera;
   ctx.settings = &settings_;
   ctx.ablation = &ablation_;
@@ -191,7 +185,10 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
           WriteGroundTruth(truth, camera, scene_, rays[i], did_hit[i], hits[i], t.x0 + x, v);
       }
     }
-    if (buffers.radiance) {
+    if (buffers.radiance && paths) {
+      secondary_rays.fetch_add(path_->TraceTile(*ray_scene_, t, stop_request_, &stopped),
+                               std::memory_order_relaxed);
+    } else if (buffers.radiance) {
       // normal maps bend the shading normals the integrators see (after the ground truth,
       // whose normals stay the surfaces'); the materials over the pixels' ray cones where the
       // integrator takes them from here.
@@ -217,17 +214,17 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
       primary.did_hit = did_hit.get();
       secondary_rays.fetch_add(integrator_->RenderTile(ctx, primary, buffers),
                                std::memory_order_relaxed);
-      if (report) {
-        const int64_t tile_samples = static_cast<int64_t>(n) * spp;
-        const int64_t done = samples_done.fetch_add(tile_samples) + tile_samples;
-        const int passes_done = static_cast<int>(std::min<int64_t>(done / pixels, spp));
-        // one report per pass crossed since the last (a tile may hold more than one pass)
-        if (std::this_thread::get_id() == caller && !stopped.load(std::memory_order_relaxed)) {
-          progress.samples_done = done;
-          while (progress.passes_done < passes_done) {
-            ++progress.passes_done;
-            progress_(progress);
-          }
+    }
+    if (report) {
+      const int64_t tile_samples = static_cast<int64_t>(n) * spp;
+      const int64_t done = samples_done.fetch_add(tile_samples) + tile_samples;
+      const int passes_done = static_cast<int>(std::min<int64_t>(done / pixels, spp));
+      // one report per pass crossed since the last (a tile may hold more than one pass)
+      if (std::this_thread::get_id() == caller && !stopped.load(std::memory_order_relaxed)) {
+        progress.samples_done = done;
+        while (progress.passes_done < passes_done) {
+          ++progress.passes_done;
+          progress_(progress);
         }
       }
     }
@@ -245,15 +242,11 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   out->stopped = stopped.load();
   if (out->stopped) return;
 
-  if (want[ImageKind::kRgb] && ablation_.film) {
-    if (denoise) {
-      DenoiserGuides guides;
-      guides.albedo = &albedo_;
-      guides.normal = &normal_;
-      guides.depth = depth;
-      denoiser_->Denoise(out->radiance, guides, &pool_, &denoised_);
-      std::swap(out->radiance, denoised_);
-    }
+  if (paths) {
+    // the chain's radiance, denoised with its guides and developed (FinishPathFrame)
+    path_->Finish(denoiser_.get(), view.white_balance_gains, ablation_.film, &pool_, out);
+    if (!ablation_.film) out->rgb = ImageU8();
+  } else if (want[ImageKind::kRgb] && ablation_.film) {
     out->ev100 = film_.Ev100(out->radiance, &pool_);
     film_.Develop(out->radiance, out->ev100, &pool_, &out->rgb, view.white_balance_gains);
   } else {

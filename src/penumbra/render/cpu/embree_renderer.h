@@ -6,14 +6,17 @@
 // recommitted only when a body moved), split the image into kTileSize x kTileSize tiles spread
 // over a thread pool, trace the pixel-centre camera ray of every pixel of a tile as one
 // coherent Embree ray stream (these hits are the depth and segmentation images: exact, never
-// blended), then let the tier's Integrator estimate the tile's radiance. radiance is exposed,
-// tone mapped and encoded by Film. every output is independent of the thread count.
+// blended), then let the tier estimate the tile's radiance: the realtime tier's Integrator, or
+// the pathtraced tier's path chain (PathTiles: render/transport/path_trace.h over Embree, then
+// denoised and developed by FinishPathFrame). radiance is exposed, tone mapped and encoded by
+// Film. every output is independent of the thread count.
 
 #include <memory>
 #include <string>
 
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cpu/integrator.h"
+#include "penumbra/render/cpu/path_tiles.h"
 #include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/film/denoiser.h"
 #include "penumbra/render/film/film.h"
@@ -68,10 +71,9 @@ class EmbreeRenderer final : public Renderer {
   SunOccluderMap sun_occluders_;    // realtime tier: sun shadow rays the static boxes block
   Film film_;
   ThreadPool pool_;
-  std::unique_ptr<Integrator> integrator_;
-  std::unique_ptr<Denoiser> denoiser_;  // pathtraced with denoise only
-  // per-frame buffers kept between frames to avoid reallocation.
-  ImageF albedo_, normal_, depth_, denoised_;
+  std::unique_ptr<Integrator> integrator_;  // the realtime tier's
+  std::unique_ptr<PathTiles> path_;         // the pathtraced tier's
+  std::unique_ptr<Denoiser> denoiser_;      // pathtraced with denoise only
 };
 
 /// the EmbreeRenderer of `scene` (copied) with `settings`.

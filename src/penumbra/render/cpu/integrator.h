@@ -1,5 +1,6 @@
 #pragma once
-// the light-transport interface shared by both render tiers. the renderer
+// the realtime tier's light-transport interface on the CPU (the pathtraced tier runs the
+// transport's path chain instead: render/cpu/path_tiles.h). the renderer
 // (render/cpu/embree_renderer) splits a frame into tiles, traces the pixel-centre camera ray
 // of every pixel of a tile once (those hits give the exact depth and segmentation
 // images), and hands them to an Integrator, which estimates the radiance of every pixel
@@ -54,8 +55,8 @@ struct FrameContext {
   /// already is the effects' sky and `lights` carry the effects' light changes.
   const MediaFrame* effects = nullptr;
   /// the renderer's stop request (Renderer::set_stop_request), or null: an integrator that
-  /// takes long per pixel (the pathtraced tier) reads it before every sample and, once it
-  /// reads non-zero, leaves the tile unfinished and sets *stopped.
+  /// takes long per pixel reads it before every sample and, once it reads non-zero, leaves the
+  /// tile unfinished and sets *stopped.
   const std::atomic<int>* stop_request = nullptr;
   std::atomic<bool>* stopped = nullptr;
 

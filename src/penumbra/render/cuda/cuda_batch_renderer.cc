@@ -9,9 +9,10 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera/camera.h"
-#include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
+#include "penumbra/render/cuda/realtime_host.h"
+#include "penumbra/render/frame/bvh_ray_query.h"
 
 namespace penumbra::cuda {
 namespace {
@@ -100,7 +101,7 @@ void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot,
   }
   w.realtime->PoseWorld(snapshot, pool_.get(), effects);
   if (!w.sky_uploaded || w.realtime->sky_generation() != w.sky_generation) {
-    w.device_realtime->UploadSky(w.realtime->SkyData());
+    w.device_realtime->UploadSky(SkyDataOf(*w.realtime));
     w.sky_generation = w.realtime->sky_generation();
     w.sky_uploaded = true;
   }

@@ -15,7 +15,7 @@
 #include <cstdint>
 
 #include "penumbra/render/cuda/cuda_kernels.h"
-#include "penumbra/render/cuda/path_buffers.h"
+#include "penumbra/render/frame/path_buffers.h"
 #include "penumbra/render/transport/path_trace.h"
 
 namespace penumbra::cuda {

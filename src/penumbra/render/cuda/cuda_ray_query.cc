@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/cuda/bvh_ray_query.h"
+#include "penumbra/render/frame/bvh_ray_query.h"
 
 namespace penumbra::cuda {
 namespace {

@@ -8,8 +8,8 @@
 #include <mutex>
 #include <span>
 
-#include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/frame/bvh_scene.h"
 #include "penumbra/render/ray_query.h"
 
 namespace penumbra::cuda {

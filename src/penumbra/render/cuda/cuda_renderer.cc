@@ -4,8 +4,9 @@
 #include <cmath>
 
 #include "penumbra/render/camera/camera.h"
-#include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
+#include "penumbra/render/cuda/realtime_host.h"
+#include "penumbra/render/frame/bvh_ray_query.h"
 #include "penumbra/render/light/emitter_sampler.h"
 #include "penumbra/scene/texture_image.h"
 
@@ -217,7 +218,7 @@ void CudaRenderer::UploadRealtime() {
   // the sky volume is built on the first frame and rebuilt or relit when the static bodies or
   // the sky change: its device copy follows
   if (!sky_uploaded_ || realtime_->sky_generation() != sky_generation_) {
-    device_realtime_->UploadSky(realtime_->SkyData());
+    device_realtime_->UploadSky(SkyDataOf(*realtime_));
     sky_generation_ = realtime_->sky_generation();
     sky_uploaded_ = true;
   }

@@ -26,15 +26,15 @@
 #include <vector>
 
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/cuda/bvh_scene.h"
-#include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/cuda/cuda_path.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/cuda_streak_cull.h"
-#include "penumbra/render/cuda/path_frame.h"
-#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/frame/bvh_scene.h"
+#include "penumbra/render/frame/camera_rays.h"
+#include "penumbra/render/frame/path_frame.h"
+#include "penumbra/render/frame/realtime_frame.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/scene/effects_frame.h"
 

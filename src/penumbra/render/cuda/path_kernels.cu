@@ -1,6 +1,6 @@
 // the pathtraced tier's kernels (cuda_path.h): each thread runs the PB_HOST_DEVICE functions of
-// render/transport/path_trace.h (a run of one pixel's samples, then a pixel's finish), which
-// RenderPathtracedOnHost runs on the CPU.
+// render/transport/path_trace.h (a run of one pixel's samples, then a pixel's finish), which the
+// CPU backend runs over Embree (render/cpu/path_tiles.h).
 
 #include <cuda_runtime.h>
 

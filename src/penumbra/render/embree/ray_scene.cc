@@ -741,6 +741,29 @@ bool RayScene::Intersect(const Ray& ray, SurfaceHit* hit) const {
   return true;
 }
 
+bool RayScene::IntersectIds(const Ray& ray, RayHitIds* ids) const {
+  if (!impl_->Traceable(ray)) return false;
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRayHit rh;
+  ToEmbree(ray, &rh.ray);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->top, &ctx, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  const int group = impl_->group_of_instance[rh.hit.instID[0]];
+  const GeomRecord& rec = impl_->groups[group].records[rh.hit.geomID];
+  ids->t = rh.ray.tfar;
+  ids->geom = rec.geom;
+  ids->segment = group == impl_->tendon_group ? static_cast<int>(rh.hit.geomID) : -1;
+  ids->analytic = rec.analytic != nullptr;
+  ids->face = ids->analytic ? 0 : static_cast<int>(rh.hit.primID);
+  ids->u = ids->analytic ? 0.0f : rh.hit.u;
+  ids->v = ids->analytic ? 0.0f : rh.hit.v;
+  ids->part = ids->analytic ? static_cast<int>(rh.hit.u) : 0;
+  return true;
+}
+
 bool RayScene::Occluded(const Ray& ray) const {
   if (!impl_->Traceable(ray)) return false;
   RTCIntersectContext ctx;

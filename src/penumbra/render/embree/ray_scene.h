@@ -59,6 +59,19 @@ namespace penumbra {
 
 struct RayCone;
 
+/// a closest hit named by what was hit rather than by its surface (RayScene::IntersectIds): the
+/// transport's Embree tracer (render/cpu/embree_tracer.h) turns it into the BVH scene's
+/// numbering (BvhScene::NameHit).
+struct RayHitIds {
+  float t = 0;       ///< ray parameter of the hit
+  int geom = -1;     ///< SceneDescription geom index; -1: a tendon's capsule (segment)
+  int segment = -1;  ///< with geom -1: the capsule's index among the tendons' finite segments
+  int face = 0;      ///< the triangle's face index in its geom's shape; 0 for analytic shapes
+  bool analytic = false;
+  float u = 0, v = 0;  ///< a triangle's barycentrics (weights of its 2nd and 3rd vertex)
+  int part = 0;        ///< an analytic shape's part (ShapePart) hit
+};
+
 /// half-size (m) of the quad that stands in for an infinite MJCF plane.
 constexpr double kInfinitePlaneHalfSize = 1e4;
 
@@ -88,6 +101,10 @@ class RayScene final : public RayQuery {
 
   /// closest hit along `ray` in [tmin, tmax]; fills `hit` and returns true, or returns false.
   bool Intersect(const Ray& ray, SurfaceHit* hit) const;
+
+  /// the closest hit along `ray` in [tmin, tmax] as Intersect finds it, named (RayHitIds)
+  /// instead of finished into a SurfaceHit; false where none.
+  bool IntersectIds(const Ray& ray, RayHitIds* ids) const;
 
   /// true if anything blocks `ray` in [tmin, tmax].
   bool Occluded(const Ray& ray) const;

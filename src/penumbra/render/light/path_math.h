@@ -1,12 +1,11 @@
 #pragma once
-// the pathtraced tier's light terms as PB_HOST_DEVICE functions over plain data, shared by the
-// CPU's PathIntegrator (render/cpu/path_integrator.cc) and the CUDA backend's path kernels
-// (render/transport/path_trace.h): the power heuristic of multiple importance sampling, the lamp
-// spheres (point and spot lights with a radius that cast shadows: their radiance, solid angle
-// and ray intersection) and the sun discs (directional lights with an angular radius). the
-// model is documented in render/cpu/path_integrator.h. every expression keeps the operation
-// order of the Eigen code it replaced (render/shading_math.h's bit-for-bit rule; dot products
-// and squared norms as Eigen sums them, EigenDot).
+// the pathtraced tier's light terms as PB_HOST_DEVICE functions over plain data, called by its
+// one chain (render/transport/path_trace.h, which both backends run): the power heuristic of
+// multiple importance sampling, the lamp spheres (point and spot lights with a radius that cast
+// shadows: their radiance, solid angle and ray intersection) and the sun discs (directional lights
+// with an angular radius). the model is documented in render/transport/path_trace.h. every
+// expression keeps the operation order of the Eigen code it replaced (render/shading_math.h's
+// bit-for-bit rule; dot products and squared norms as Eigen sums them, EigenDot).
 
 #include <cmath>
 

@@ -124,7 +124,7 @@ struct TextureFootprint {
 
 /// the footprint at `hit` of a cone of spread angle `spread_rad` around a ray of unit direction
 /// `d_unit`, `distance_m` long from the cone's apex (or `distance_m` plus the width the cone had
-/// at its origin, see path_integrator): width spread_rad x distance_m.
+/// at its origin, see render/transport/path_trace.h): width spread_rad x distance_m.
 TextureFootprint ConeFootprint(float spread_rad, float distance_m, const Eigen::Vector3f& d_unit,
                                const SurfaceHit& hit);
 

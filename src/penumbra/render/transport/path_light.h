@@ -24,10 +24,10 @@
 
 namespace penumbra::cuda {
 
-/// Russian roulette starts at this path vertex (render/cpu/path_integrator.h's
-/// kRussianRouletteStartVertex).
+/// Russian roulette starts at this path vertex (0 = the first hit: after 3 bounces); a path goes
+/// on with probability q = min(1, its throughput's largest channel), reweighted by 1 / q.
 constexpr int kPathRussianRouletteStartVertex = 3;
-/// shadow rays towards a point at distance d stop this fraction short of it (the CPU's).
+/// shadow rays towards a point at distance d stop this fraction short of it.
 constexpr float kPathShadowShorten = 1e-4f;
 
 /// the scene's emissive geoms as the path samples them (EmitterSampler's,

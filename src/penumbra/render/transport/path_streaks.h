@@ -1,10 +1,9 @@
 #pragma once
 // the particle streaks (rain, snow, sparks) of a pathtraced frame as the path kernels trace
 // them, written once as PB_HOST_DEVICE functions over plain data: the GPU (path_kernels.cu) and
-// the host path (RenderPathtracedOnHost) run them. every streak is the capsule of the CPU's
+// the CPU backend (render/cpu/path_tiles.h) run them. every streak is the capsule of
 // ParticleStreaks (render/particles/particle_streaks.h: the segment a particle sweeps in the
-// exposure, its widened radius), which the CPU backend traces as an Embree round linear curve
-// (render/embree/particle_scene.h); here a BVH over the capsules' boxes (built on the host per
+// exposure, its widened radius); a BVH over the capsules' boxes (built on the host per
 // frame by bvh_builder.h's binned SAH, path_streak_build.h) is traversed by the scene's own
 // traversal (TraverseWideBvh) with Quilez's ray-capsule test (render/particles/particle_math.h's
 // IntersectCapsule, which the realtime tier's splat calls too), and a hit streak is shaded by

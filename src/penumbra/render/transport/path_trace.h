@@ -1,10 +1,19 @@
 #pragma once
-// the pathtraced tier, per pixel, as PB_HOST_DEVICE functions over plain data:
-// path_kernels.cu runs them on the GPU (one thread a run of one pixel's samples, the runs of a
-// pixel then summed in run order: PathSampleRange, PathFinishPixel) and RenderPathtracedOnHost
-// (path_frame.h) runs the same functions on the CPU over the host BVH (tests, machines without
-// a GPU). the path is the CPU's PathIntegrator (render/cpu/path_integrator.h, where the model is
-// documented) step for step, with media and particles:
+// the pathtraced tier, per pixel, as PB_HOST_DEVICE functions over plain data, written once for
+// both processors: path_kernels.cu runs them on the GPU (one thread a run of one pixel's samples,
+// the runs of a pixel then summed in run order: PathSampleRange, PathFinishPixel) and the CPU
+// backend (render/cpu/path_tiles.h) runs PathTracePixel over Embree, pixel by pixel in tiles.
+//
+// the model: unidirectional path tracing with next-event estimation and multiple importance
+// sampling (Veach, "Robust Monte Carlo methods for light transport simulation", PhD thesis,
+// Stanford 1997, ch. 9; power heuristic with beta = 2); lamp spheres and sun discs are visible to
+// every ray (not in the realtime tier); with max_bounces = b a path gathers light that scattered
+// at most b times (b = 1: direct lighting). outputs per pixel: the mean radiance (non-finite
+// paths dropped); the denoiser guides: albedo = mean base colour of the first surface over the
+// samples that hit one, normal = shading normal of the pixel-centre hit, depth = its t.
+// textures are filtered over the pixel's ray cone (spread angle Camera::pixel_spread_rad, width
+// at a vertex that angle times the path's length from the camera: the cone of a chain of flat
+// mirrors; rough bounces' spread is left out). the draws, with media and particles:
 //
 //   per sample s of pixel (u, v): Rng(PixelStream(u, v, s)) (core/rng.h, the same draws in the
 //   same order), a camera ray jittered over the pixel (two draws); at each vertex the lamp
@@ -25,8 +34,9 @@
 // the ray tracer is the chain's one seam to the processor: a Tracer (template parameter, passed
 // by the caller) with Closest(const TraceRay&, TraceHit*) (hit->instance -1: none) and
 // Occluded(const TraceRay&) -> bool, its hits numbered as pf.rt.scene's arrays (instance, prim,
-// u, v, part, t), from which the surface at a hit is read (EvaluateSurface). the GPU and the
-// host runner pass BvhTracer (render/bvh/bvh_traversal.h) over pf.rt.scene.
+// u, v, part, t), from which the surface at a hit is read (EvaluateSurface). the GPU passes
+// BvhTracer (render/bvh/bvh_traversal.h) over pf.rt.scene, the CPU EmbreeTracer
+// (render/cpu/embree_tracer.h: Embree's hits named as the BVH scene names them).
 //
 // with the shared formulas of render/: the BSDF (bsdf_math.h), the light samples (light_math.h,
 // with LightSampler::Sample's normalisation), the lamp and sun terms and the power heuristic
@@ -36,9 +46,9 @@
 // phase functions), dot products summed as the CPU's Eigen code sums them (EigenDot),
 // and the materials with their textures over the path's ray cone as the
 // realtime tier evaluates them (EvaluateSurface, surface.h). the GPU contracts
-// multiply-adds, so its paths differ from the CPU's by float rounding, which a path's branches
-// (Russian roulette, lobe choice) can turn into other paths: the estimates agree in the mean
-// (docs/journal/2026-11-27-gpu-pathtraced.md, "The pathtraced tier on the GPU").
+// multiply-adds and traces with its own BVH, so its paths differ from the CPU's by float
+// rounding, which a path's branches (Russian roulette, lobe choice) can turn into other paths:
+// the estimates agree in the mean (docs/journal/2026-11-29-path-cpu.md).
 
 #include <cstdint>
 
@@ -343,19 +353,36 @@ PB_HOST_DEVICE inline void PathFinishPixel(const PathFrameView& pf, const Tracer
   pf.normal[i] = sp.n;
 }
 
-/// pixel (u, v) of a pathtraced frame in one run: all pf.spp samples (PathSampleRange) summed in
-/// sample order in double, as the CPU's PathIntegrator sums them, then PathFinishPixel
-/// (TracePath<true, ...> where the frame has media, TracePath<..., true> where it has streaks).
+/// samples [s0, s1) of pixel (u, v) by the TracePath instance of the frame: TracePath<true, ...>
+/// where it has media (pf.media), TracePath<..., true> where it has particle streaks
+/// (pf.streaks.num > 0); PathSampleRange's sums.
 template <class Tracer>
-PB_HOST_DEVICE inline void PathTracePixel(const PathFrameView& pf, const Tracer& tracer, int u,
-                                          int v) {
+PB_HOST_DEVICE inline PathPartial PathSamples(const PathFrameView& pf, const Tracer& tracer, int u,
+                                              int v, int s0, int s1) {
   const bool media = MediaAny(pf.media), particles = pf.streaks.num > 0;
-  const int n = pf.spp;
-  PathFinishPixel(pf, tracer, u, v,
-                  particles ? (media ? PathSampleRange<true, true>(pf, tracer, u, v, 0, n)
-                                     : PathSampleRange<false, true>(pf, tracer, u, v, 0, n))
-                            : (media ? PathSampleRange<true>(pf, tracer, u, v, 0, n)
-                                     : PathSampleRange<false>(pf, tracer, u, v, 0, n)));
+  return particles ? (media ? PathSampleRange<true, true>(pf, tracer, u, v, s0, s1)
+                            : PathSampleRange<false, true>(pf, tracer, u, v, s0, s1))
+                   : (media ? PathSampleRange<true>(pf, tracer, u, v, s0, s1)
+                            : PathSampleRange<false>(pf, tracer, u, v, s0, s1));
+}
+
+/// pixel (u, v) of a pathtraced frame in one run: its pf.spp samples one after the other
+/// (PathSamples), summed in sample order in double (the bits of one PathSampleRange over them
+/// all), then PathFinishPixel. `stop()` is asked before every sample: once it returns true the
+/// pixel is left unwritten and false is returned (a stop waits for at most one path).
+template <class Tracer, class Stop>
+PB_HOST_DEVICE inline bool PathTracePixel(const PathFrameView& pf, const Tracer& tracer, int u,
+                                          int v, const Stop& stop) {
+  PathPartial p;
+  for (int s = 0; s < pf.spp; ++s) {
+    if (stop()) return false;
+    // one sample's sums are its values (0 + x is x): adding them in order is the one range's sum
+    const PathPartial q = PathSamples(pf, tracer, u, v, s, s + 1);
+    for (int c = 0; c < 3; ++c) p.L[c] += q.L[c], p.albedo[c] += q.albedo[c];
+    p.albedo_count += q.albedo_count;
+  }
+  PathFinishPixel(pf, tracer, u, v, p);
+  return true;
 }
 
 /// the sample runs of a frame of n pixels and spp samples on a processor that wants about

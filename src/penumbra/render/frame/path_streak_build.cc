@@ -1,4 +1,4 @@
-#include "penumbra/render/cuda/path_streak_build.h"
+#include "penumbra/render/frame/path_streak_build.h"
 
 #include <algorithm>
 #include <chrono>

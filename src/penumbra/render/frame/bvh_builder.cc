@@ -1,4 +1,4 @@
-#include "penumbra/render/cuda/bvh_builder.h"
+#include "penumbra/render/frame/bvh_builder.h"
 
 #include <algorithm>
 #include <cmath>

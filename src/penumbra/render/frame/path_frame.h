@@ -1,21 +1,19 @@
 #pragma once
-// the host side of the pathtraced tier on the GPU (render/transport/path_trace.h per pixel,
-// path_kernels.cu on the device): which frames it takes, the frame's plain data (PathFrameView over
-// a prepared RealtimeFrameData: the same posed scene, materials, textures, lights and sky), and the
-// finish every pathtraced frame gets on the host, as the CPU backend's EmbreeRenderer gives it: the
-// a-trous denoiser (render/film/denoiser.h, guided by the albedo, normal and depth) when the
-// settings ask for it, then the film's auto exposure and development (render/film/film.h).
-// RenderPathtracedOnHost runs the GPU path's per-pixel functions on the CPU over the host BVH
-// (tests; the parity check without a GPU). no CUDA runtime here.
+// the host side of the pathtraced tier (render/transport/path_trace.h per pixel: the GPU's
+// path_kernels.cu, the CPU's render/cpu/path_tiles.h): the frame's plain data (PathFrameView over
+// a prepared RealtimeFrameData: the same posed scene, materials, textures, lights and sky; the
+// emissive geoms), and the finish every pathtraced frame gets on the host: the a-trous denoiser
+// (render/film/denoiser.h, guided by the chain's albedo, normal and depth) when the settings ask
+// for it, then the film's auto exposure and development (render/film/film.h). no CUDA runtime
+// here.
 
 #include <vector>
 
 #include "penumbra/core/image.h"
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/cuda/bvh_scene.h"
-#include "penumbra/render/cuda/path_buffers.h"
-#include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/film/denoiser.h"
+#include "penumbra/render/frame/path_buffers.h"
+#include "penumbra/render/frame/realtime_frame.h"
 #include "penumbra/render/light/emitter_sampler.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/render/transport/path_trace.h"
@@ -52,23 +50,6 @@ PathFrameView PathView(const RealtimeFrameData& data, const RealtimeFrameView& f
 void FinishPathFrame(const RealtimeFrameData& data, const PathBuffers& b, const Denoiser* denoiser,
                      const Eigen::Vector3f& white_balance_gains, bool want_depth, ThreadPool* pool,
                      RenderedFrame* out);
-
-/// the paths of frame `pf` (host arrays; its outputs are set here) traced by PathTracePixel on
-/// the CPU, rows over `pool`, into `out` (resized to the camera's pixels).
-void TracePathtracedOnHost(const PathFrameView& pf, ThreadPool* pool, PathBuffers* out);
-
-/// a pathtraced frame of `data` (Prepared for the view; its settings' samples_per_pixel and
-/// max_bounces) rendered by PathTracePixel on the CPU over `bvh` (Updated for the snapshot),
-/// rows over `pool`, finished by FinishPathFrame (denoised when the settings ask for it): the
-/// GPU path's radiance, depth and rgb, computed on the host (`white_balance_gains`: the view's).
-/// `emitters`: the scene's emissive geoms posed for the snapshot (null: none); `media`: the
-/// frame's media (MediaScene::View; null: none); the particle streaks are data's own
-/// (path_streaks(), Prepared with the effects).
-void RenderPathtracedOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
-                            RenderedFrame* out,
-                            const Eigen::Vector3f& white_balance_gains = Eigen::Vector3f::Ones(),
-                            const PathEmitters* emitters = nullptr,
-                            const MediaSceneView* media = nullptr);
 
 /// `effects` without its media (null where nothing else is left): what the pathtraced tier's
 /// RealtimeFrameData::Prepare takes (the paths trace the media themselves, so the realtime

@@ -12,8 +12,8 @@
 
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/camera/camera.h"
-#include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/transport/primary_pixel.h"
 
 namespace penumbra::cuda {
 

@@ -1,4 +1,4 @@
-#include "penumbra/render/cuda/camera_rays.h"
+#include "penumbra/render/frame/camera_rays.h"
 
 namespace penumbra::cuda {
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "penumbra/render/bvh/bvh_types.h"
-#include "penumbra/render/cuda/bvh_builder.h"
+#include "penumbra/render/frame/bvh_builder.h"
 #include "penumbra/render/particles/particle_streaks.h"
 #include "penumbra/render/transport/path_streaks.h"
 

@@ -1,11 +1,13 @@
-// light transport of the pathtraced tier: furnace tests, agreement with the realtime tier and
-// with analytic values, multiple importance sampling against a quadrature reference, and
-// determinism across thread counts.
+// the pathtraced tier on the CPU (the transport's path chain over Embree, render/cpu/
+// path_tiles.h): furnace tests, agreement with the realtime tier and with analytic values,
+// multiple importance sampling against a quadrature reference, determinism across thread
+// counts, and the stop request.
 
-#include "penumbra/render/cpu/path_integrator.h"
+#include "penumbra/render/cpu/path_tiles.h"
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -49,7 +51,7 @@ double MeanOver(const RenderedFrame& f, int id, int c, int* count) {
   return n ? sum / n : 0.0;
 }
 
-TEST(PathIntegratorTest, FurnaceDiffuseSphereInUniformSky) {
+TEST(PathtracedCpu, FurnaceDiffuseSphereInUniformSky) {
   // a white Lambertian-like sphere (base colour 1, roughness 1, no specular) in a uniform sky
   // of radiance L reflects L wherever it is seen (it never sees itself).
   SceneDescription s = EmptyScene();
@@ -87,7 +89,7 @@ TEST(PathIntegratorTest, FurnaceDiffuseSphereInUniformSky) {
   RecordProperty("worst_pixel_error", std::to_string(worst));
 }
 
-TEST(PathIntegratorTest, FurnaceClosedEmissiveBox) {
+TEST(PathtracedCpu, FurnaceClosedEmissiveBox) {
   // inside a closed box whose walls have albedo rho and emission Le, radiance is
   // Le (1 + rho + rho^2 + ...) = Le / (1 - rho) everywhere; needs many bounces and unbiased
   // Russian roulette.
@@ -111,7 +113,7 @@ TEST(PathIntegratorTest, FurnaceClosedEmissiveBox) {
   RecordProperty("one_bounce_mean_error", std::to_string(mean1 / (le * (1 + rho)) - 1));
 }
 
-TEST(PathIntegratorTest, LambertianPlaneUnderDirectionalLight) {
+TEST(PathtracedCpu, LambertianPlaneUnderDirectionalLight) {
   const float rho = 0.6f, E = 1000.0f;
   for (double incidence_deg : {0.0, 50.0}) {
     SceneDescription s = EmptyScene();
@@ -158,7 +160,7 @@ SceneDescription DirectLightingScene() {
   return s;
 }
 
-TEST(PathIntegratorTest, AgreesWithRealtimeTierOnDirectLighting) {
+TEST(PathtracedCpu, AgreesWithRealtimeTierOnDirectLighting) {
   // the path tracer averages each pixel's area (jittered camera rays); the realtime tier
   // samples the pixel centre, so it renders at 5x resolution and is box-downsampled.
   const SceneDescription s = DirectLightingScene();
@@ -200,7 +202,7 @@ TEST(PathIntegratorTest, AgreesWithRealtimeTierOnDirectLighting) {
   RecordProperty("image_sum_error", std::to_string(sum_pt / sum_rt - 1));
 }
 
-TEST(PathIntegratorTest, ImagesDoNotDependOnThreadCount) {
+TEST(PathtracedCpu, ImagesDoNotDependOnThreadCount) {
   // every light kind, a daylight sky, an emissive box and several bounces.
   SceneDescription s = DirectLightingScene();
   s.sky.type = Sky::Type::kDaylight;
@@ -211,13 +213,23 @@ TEST(PathIntegratorTest, ImagesDoNotDependOnThreadCount) {
   s.materials[glow].emission = {300, 200, 100};
   AddGeom(&s, GeomShape::kBox, {0.1, 0.1, 0.1}, Translation(-0.4, -0.3, 0.1), 0, glow);
   const CameraView view = MakeView(CameraLookingDown({0, 0, 2.5}), 40, 30, 70);
-  RenderSettings one = PathSettings(4, 4, 1), two = PathSettings(4, 4, 2);
-  one.denoise = two.denoise = true;
+  RenderSettings one = PathSettings(4, 4, 1), two = PathSettings(4, 4, 2),
+                 three = PathSettings(4, 4, 3);
+  one.denoise = two.denoise = three.denoise = true;
   const RenderedFrame a = Render(s, one, view), b = Render(s, two, view);
   ASSERT_EQ(a.radiance.data.size(), b.radiance.data.size());
   EXPECT_EQ(0, std::memcmp(a.radiance.data.data(), b.radiance.data.data(),
                            a.radiance.data.size() * sizeof(float)));
   EXPECT_EQ(a.rgb.data, b.rgb.data);
+  // three threads take the 16x16 tiles in another order: the same bits
+  const RenderedFrame d = Render(s, three, view);
+  EXPECT_EQ(0, std::memcmp(a.radiance.data.data(), d.radiance.data.data(),
+                           a.radiance.data.size() * sizeof(float)));
+  EXPECT_EQ(a.rgb.data, d.rgb.data);
+  // every pixel was traced: some light everywhere the camera looks (the floor fills the view)
+  int dark = 0;
+  for (float x : a.radiance.data) dark += !(x > 0);
+  EXPECT_LT(dark, static_cast<int>(a.radiance.data.size()) / 10);
   // and a different frame index gives different noise.
   CameraView later = view;
   later.frame_index = 1;
@@ -226,7 +238,7 @@ TEST(PathIntegratorTest, ImagesDoNotDependOnThreadCount) {
                            a.radiance.data.size() * sizeof(float)));
 }
 
-TEST(PathIntegratorTest, SphereLampMatchesInverseSquareLaw) {
+TEST(PathtracedCpu, SphereLampMatchesInverseSquareLaw) {
   // a lamp of radius r and intensity I is a sphere of radiance I / (pi r^2); on a Lambertian
   // floor it gives E = I cos(theta) / d^2 exactly (the sphere is above the horizon), and the
   // camera sees it at that radiance.
@@ -290,7 +302,7 @@ double GlossyReference(const PbrParams& params, const Eigen::Vector3f& p, const 
   return sum * le;
 }
 
-TEST(PathIntegratorTest, MisGlossyReflectionOfSmallEmissiveSphere) {
+TEST(PathtracedCpu, MisGlossyReflectionOfSmallEmissiveSphere) {
   // a small emissive sphere seen in a glossy floor: the MIS estimate (emitter sampling +
   // BSDF sampling) converges to the reflected radiance computed by quadrature.
   for (float roughness : {0.15f, 0.4f}) {
@@ -330,6 +342,25 @@ TEST(PathIntegratorTest, MisGlossyReflectionOfSmallEmissiveSphere) {
     EXPECT_NEAR(mean, ref, 0.03 * ref) << "roughness " << roughness;
     RecordProperty("error_roughness_" + std::to_string(roughness), std::to_string(mean / ref - 1));
   }
+}
+
+TEST(PathtracedCpu, AStopRequestEndsTheFrameUnfinished) {
+  // a stop request already set: no tile traces a sample, the frame is marked stopped and not
+  // developed; cleared, the same renderer renders the frame in full.
+  SceneDescription s = DirectLightingScene();
+  const CameraView view = MakeView(CameraLookingDown({0, 0, 2.5}), 40, 30, 70);
+  auto r = MakeRenderer(s, PathSettings(64, 4, 2));
+  std::atomic<int> stop{1};
+  r->set_stop_request(&stop);
+  RenderedFrame f;
+  r->Render(IdentitySnapshot(s), view, &f);
+  EXPECT_TRUE(f.stopped);
+  EXPECT_TRUE(f.rgb.data.empty());
+  stop = 0;
+  r->Render(IdentitySnapshot(s), view, &f);
+  EXPECT_FALSE(f.stopped);
+  EXPECT_EQ(f.rgb.width, 40);
+  EXPECT_EQ(f.rgb.height, 30);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-#include "penumbra/render/cuda/bvh_ray_query.h"
+#include "penumbra/render/frame/bvh_ray_query.h"
 
 #include <memory>
 

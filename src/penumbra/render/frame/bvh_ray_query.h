@@ -6,7 +6,7 @@
 
 #include <span>
 
-#include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/frame/bvh_scene.h"
 #include "penumbra/render/ray_query.h"
 
 namespace penumbra::cuda {

@@ -1,4 +1,4 @@
-#include "penumbra/render/cuda/path_frame.h"
+#include "penumbra/render/frame/path_frame.h"
 
 #include <algorithm>
 #include <memory>
@@ -53,7 +53,8 @@ PathFrameView PathView(const RealtimeFrameData& data, const RealtimeFrameView& f
   PathFrameView pf;
   pf.rt = frame;
   pf.sky_sampling = sky_sampling;
-  // the sky lights the scene where its irradiance up or down is > 0 (PathIntegrator's rule)
+  // the sky lights the scene where its irradiance up or down is > 0 (a sky of no light is not
+  // sampled)
   const SkyModel& sky = data.frame_sky();
   const Eigen::Vector3f up = sky.Irradiance({0, 0, 1});
   const Eigen::Vector3f down = sky.Irradiance({0, 0, -1});
@@ -103,34 +104,6 @@ void FinishPathFrame(const RealtimeFrameData& data, const PathBuffers& b, const 
   } else {
     out->depth_m = ImageF();
   }
-}
-
-void TracePathtracedOnHost(const PathFrameView& frame, ThreadPool* pool, PathBuffers* out) {
-  const int W = frame.rt.camera.width, H = frame.rt.camera.height;
-  out->Resize(static_cast<int64_t>(W) * H);
-  PathFrameView pf = frame;
-  pf.radiance = out->radiance.data();
-  pf.albedo = out->albedo.data();
-  pf.normal = out->normal.data();
-  pf.depth = out->depth.data();
-  ParallelForOrSerial(pool, H, [&](int64_t v) {
-    for (int u = 0; u < W; ++u) PathTracePixel(pf, BvhTracer{pf.rt.scene}, u, static_cast<int>(v));
-  });
-}
-
-void RenderPathtracedOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
-                            RenderedFrame* out, const Eigen::Vector3f& white_balance_gains,
-                            const PathEmitters* emitters, const MediaSceneView* media) {
-  PathBuffers b;
-  PathFrameView pf =
-      PathView(data, data.View(bvh.view(), nullptr), data.frame_sky().sampling_pod());
-  if (emitters != nullptr) pf.emitters = *emitters;
-  if (media != nullptr) pf.media = *media;
-  pf.streaks = data.path_streaks().View();
-  TracePathtracedOnHost(pf, pool, &b);
-  std::unique_ptr<Denoiser> denoiser;
-  if (data.settings().denoise) denoiser = std::make_unique<Denoiser>();
-  FinishPathFrame(data, b, denoiser.get(), white_balance_gains, true, pool, out);
 }
 
 }  // namespace penumbra::cuda

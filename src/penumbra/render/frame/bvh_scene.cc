@@ -1,4 +1,4 @@
-#include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/frame/bvh_scene.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -171,6 +171,9 @@ void BvhScene::BuildAll() {
   records_.clear();
   record_group_.clear();
   X_GI_.clear();
+  record_first_input_.clear();
+  prim_of_input_.clear();
+  record_of_geom_.assign(scene_.geoms.size(), -1);
   for (size_t k = 0; k < groups_.size(); ++k) {
     if (static_cast<int>(k) == tendon_group_)
       tendon_start_ = {nodes_.size(), prims_.size(), analytics_.size(), records_.size(),
@@ -218,6 +221,8 @@ void BvhScene::BuildGroup(int k, std::vector<int32_t>* prim_index) {
       records_.push_back(rec);
       record_group_.push_back(k);
       X_GI_.push_back(X_IG.inverse());
+      record_first_input_.push_back(static_cast<int32_t>(prims_.size()));
+      record_of_geom_[gi] = record;
       AddGeom(gi, X_IG, &boxes, record);
     }
   }
@@ -233,6 +238,9 @@ void BvhScene::BuildGroup(int k, std::vector<int32_t>* prim_index) {
   leaf_order.reserve(boxes.size());
   for (size_t i = prim_base; i < prims_.size(); ++i) leaf_order.push_back(prims_[(*prim_index)[i]]);
   std::copy(leaf_order.begin(), leaf_order.end(), prims_.begin() + prim_base);
+  prim_of_input_.resize(prims_.size(), -1);
+  for (size_t i = prim_base; i < prims_.size(); ++i)
+    prim_of_input_[(*prim_index)[i]] = static_cast<int32_t>(i);
   Blas blas;
   WidenBvh(tree, &nodes_, &blas);
   g.blas = static_cast<int>(blases_.size());
@@ -265,6 +273,7 @@ void BvhScene::AddTendons(int k, std::vector<PrimBox>* boxes) {
       records_.push_back(rec);
       record_group_.push_back(k);
       X_GI_.push_back(X_IG.inverse());
+      record_first_input_.push_back(static_cast<int32_t>(prims_.size()));
       const double size[3] = {tendon.width_m, 0.5 * length, 0};
       AddAnalytic(capsule ? AnalyticKind::kCapsule : AnalyticKind::kSphere, size, X_IG,
                   "a segment of tendon '" + tendon.name + "'", boxes, record);
@@ -280,6 +289,8 @@ void BvhScene::RebuildTendons() {
   records_.resize(t.records);
   record_group_.resize(t.records);
   X_GI_.resize(t.records);
+  record_first_input_.resize(t.records);
+  prim_of_input_.resize(t.prims);
   blases_.resize(t.blases);
   // BuildBvh appends the group's order after one element per primitive before it
   std::vector<int32_t> prim_index(t.prims, 0);
@@ -297,9 +308,11 @@ void BvhScene::RebuildTendons() {
 
 void BvhScene::SetInstances() {
   instances_.clear();
+  instance_of_group_.assign(groups_.size(), -1);
   for (size_t k = 0; k < groups_.size(); ++k) {
     Group& g = groups_[k];
     if (g.blas < 0) continue;
+    instance_of_group_[k] = static_cast<int32_t>(instances_.size());
     g.X_WI = g.body < 0 ? Pose::Identity() : X_WB_[g.body];
     Instance in;
     in.blas = g.blas;
@@ -385,6 +398,26 @@ void BvhScene::Update(const WorldSnapshot& snapshot) {
   }
   if (tendons_moved) RebuildTendons();
   SetInstances();
+}
+
+bool BvhScene::NameHit(int geom, int segment, int face, TraceHit* th) const {
+  int record = -1;
+  if (geom >= 0) {
+    if (geom < static_cast<int>(record_of_geom_.size())) record = record_of_geom_[geom];
+  } else if (tendon_group_ >= 0 && segment >= 0) {
+    record = static_cast<int>(tendon_start_.records) + segment;
+  }
+  if (record < 0 || record >= static_cast<int>(records_.size())) return false;
+  const int64_t input = static_cast<int64_t>(record_first_input_[record]) + face;
+  const int64_t end = record + 1 < static_cast<int>(records_.size())
+                          ? record_first_input_[record + 1]
+                          : static_cast<int64_t>(prims_.size());
+  if (face < 0 || input >= end) return false;
+  const int32_t instance = instance_of_group_[record_group_[record]];
+  if (instance < 0) return false;
+  th->prim = prim_of_input_[input];
+  th->instance = instance;
+  return true;
 }
 
 SceneView BvhScene::view() const {

@@ -11,13 +11,13 @@
 // PrepareMedia, RealtimeMedia's layouts built on the host and its four volumes (the grids' light
 // volumes and froxels, the world light volume, the fog froxels) by the frame itself on the
 // device; the kernels' view pass draws them and
-// the streaks seen through them); the sky model and sky volume (SkyData, for
+// the streaks seen through them); the sky model and sky volume (render/cuda's SkyDataOf, for
 // DeviceRealtime::UploadSky) and, for the host path, the per-pixel sky terms from the primary rays'
 // geometry (QuadSkyTerms of render/transport/realtime_shading.h: the shared lookups of
 // render/sky/sky_eval_math.h, which the device's sky kernel runs too) and those of the mirror
 // layer's reflected rays (MirrorSkyTerms); and the film's exposure and encoding table.
-// RenderRealtimeOnHost runs the GPU path's per-pixel functions on the CPU over the host BVH (tests;
-// the parity check without a GPU). no CUDA runtime here: this file builds on machines without nvcc.
+// render/cuda/realtime_host.h's RenderRealtimeOnHost runs the GPU path's per-pixel functions on
+// the CPU over the host BVH (tests). plain C++: both backends read it (render/frame).
 
 #include <cstdint>
 #include <functional>
@@ -27,11 +27,10 @@
 
 #include "penumbra/core/image.h"
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/cuda/bvh_scene.h"
-#include "penumbra/render/cuda/camera_rays.h"
-#include "penumbra/render/cuda/cuda_realtime.h"
-#include "penumbra/render/cuda/path_streak_build.h"
 #include "penumbra/render/film/film.h"
+#include "penumbra/render/frame/bvh_scene.h"
+#include "penumbra/render/frame/camera_rays.h"
+#include "penumbra/render/frame/path_streak_build.h"
 #include "penumbra/render/light/light_sampler.h"
 #include "penumbra/render/media/media_realtime.h"
 #include "penumbra/render/media/media_scene.h"
@@ -202,9 +201,9 @@ class RealtimeFrameData {
   void FrameSkyTerms(const PixelGeometry* geometry, const PixelGeometry* mirror, int64_t n,
                      Float3* sky, Float3* mirror_sky, ThreadPool* pool, int row0, int row1) const;
 
-  /// the sky model's and the sky volume's plain data (host arrays) for the device copies
-  /// (DeviceRealtime::UploadSky); current while sky_generation() is unchanged.
-  RealtimeSky SkyData() const;
+  /// the frame's occluded sky irradiance volume (the sky's plain data for the device copies:
+  /// render/cuda's SkyDataOf); current while sky_generation() is unchanged.
+  const SkyIrradianceVolume& sky_volume() const { return volume_; }
   /// changes whenever Prepare rebuilt or relit the sky volume (also when the effects changed
   /// the sky: the volume is relit with it).
   uint64_t sky_generation() const { return volume_.generation(); }
@@ -305,41 +304,5 @@ class RealtimeFrameData {
 
 /// the pinhole camera of `view` as the kernels take it (view must be a projective camera).
 PinholeCamera PinholeCameraOf(const CameraView& view);
-
-/// the host arrays of the media volumes a frame builds itself (BuildMediaVolumesOnHost).
-struct MediaVolumeArrays {
-  std::vector<float> trans, vis;  // the world light volume, [cell][light]
-  std::vector<Rgb4> fog;          // the fog froxels' records
-  std::vector<float> inv_log_far;
-  GridVolumeArrays grids;  // the grids' light volumes and froxels
-};
-
-/// the media volumes that frame f leaves to itself (f->media_build) built on the CPU with the
-/// kernels' functions over `pool` into *out, and f->media pointed at them, in the device's
-/// order: the grids' light volumes (MediaGridLightCell, its shadow rays through f->scene), the
-/// grid froxels (MediaGridFroxelColumn), the world light volume (MediaLightVolumeCell), the fog
-/// froxels (MediaFogColumn). nothing without media or such volumes.
-void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolumeArrays* out);
-
-/// renders a realtime frame (rgb, radiance, depth) with the GPU path's per-pixel functions on
-/// the CPU over `bvh` (posed for the frame) and `data` (Prepared for it): the parity of the GPU
-/// path with the CPU backend can be checked on machines without a GPU. rows over `pool`.
-/// `stored_surface`: shade each pixel from the material terms its primary geometry kept
-/// (ShadeRealtimeStored, the kernels' default) instead of evaluating the surface again
-/// (ShadeRealtimePixel); the two give the same bits. `strided_terms` (with stored_surface):
-/// the lights' terms wait between ShadeRealtimePoint's loops in a row's array interleaved over
-/// its pixels (StridedLightTerms, as the shading kernel's shared memory) instead of each pixel's
-/// own (LocalLightTerms); the same bits. `queued_shadows` (with stored_surface, at most
-/// kMaxQueuedShadowLights lights): the shadow rays apart in three passes as the kernels'
-/// queued shadow rays (ShadeQueuedStored, each ray traced from QueuedRay, SumQueuedLights; the
-/// lights' terms in each pixel's own arrays); the same bits. `tiled_visibility`: the shared
-/// visibility by 16x16 shadow tiles, each tile's verdicts, ray counts and fractions copied into
-/// tile arrays where the windows find their neighbours, as the kernels' blocks do in shared
-/// memory (SharedVisibilityRays' tile form, SharedWindowFraction, SharedLampFraction); the same
-/// bits.
-void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
-                          RenderedFrame* out, bool stored_surface = false,
-                          bool strided_terms = false, bool queued_shadows = false,
-                          bool tiled_visibility = false);
 
 }  // namespace penumbra::cuda

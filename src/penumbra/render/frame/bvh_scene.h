@@ -1,17 +1,17 @@
 #pragma once
-// the CUDA backend's scene on the host: the SceneDescription's traced geoms (those RayScene
-// traces: groups <= 2, material alpha >= 0.5) as the flat arrays of bvh_types.h. boxes,
-// meshes and height fields are triangles (render/geometry/triangle_shapes.h), planes, spheres,
-// capsules, ellipsoids and cylinders analytic (render/geometry/analytic_shapes.h), grouped as
-// RayScene groups them: the static bodies merged in the world frame, every moving body on its own.
-// Update rewrites the instances' transforms from a snapshot and rebuilds the top level over their
-// world boxes (a few hundred at most; the BLASes are built once, the static one again only if a
-// static body moved, normally once, at the first Update). visible spatial
-// tendons (SceneDescription::tendons) are a last group in the world frame, as RayScene draws
-// them: a capsule of the tendon's width around each segment of the snapshot's wrap-point paths
-// (a sphere where a segment is shorter than 1e-9 m), records with geom -1 (segmentation:
-// background), the tendon's material; Update rebuilds that group's BLAS alone when the paths
-// changed.
+// the traced scene as the transport reads it (the GPU's traversal walks these arrays; the CPU's
+// EmbreeTracer names its hits by them, NameHit), built on the host: the SceneDescription's traced
+// geoms (those RayScene traces: groups <= 2, material alpha >= 0.5) as the flat arrays of
+// bvh_types.h. boxes, meshes and height fields are triangles (render/geometry/triangle_shapes.h),
+// planes, spheres, capsules, ellipsoids and cylinders analytic (render/geometry/analytic_shapes.h),
+// grouped as RayScene groups them: the static bodies merged in the world frame, every moving body
+// on its own. Update rewrites the instances' transforms from a snapshot and rebuilds the top level
+// over their world boxes (a few hundred at most; the BLASes are built once, the static one again
+// only if a static body moved, normally once, at the first Update). visible spatial tendons
+// (SceneDescription::tendons) are a last group in the world frame, as RayScene draws them: a
+// capsule of the tendon's width around each segment of the snapshot's wrap-point paths (a sphere
+// where a segment is shorter than 1e-9 m), records with geom -1 (segmentation: background), the
+// tendon's material; Update rebuilds that group's BLAS alone when the paths changed.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -20,7 +20,7 @@
 
 #include "penumbra/core/pose.h"
 #include "penumbra/render/bvh/bvh_types.h"
-#include "penumbra/render/cuda/bvh_builder.h"
+#include "penumbra/render/frame/bvh_builder.h"
 #include "penumbra/render/ray.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
@@ -52,6 +52,13 @@ class BvhScene {
   /// ray `ray`: ns_W the vertex normals' mix where the triangle has them (HitShadingNormal,
   /// primary_pixel.h, as the GPU shades it), else ng_W; uv from HitTexcoords; as RayScene.
   void FinishHit(const Ray& ray, const TraceHit& th, SurfaceHit* hit) const;
+
+  /// the closest hit `th` (its t, u, v, part left as given) named as the traversal names it:
+  /// th->prim and th->instance of a primitive named as RayScene (render/embree/ray_scene.h)
+  /// names it: geom `geom` (a SceneDescription index; -1: the tendons' capsule number `segment`
+  /// in the order both scenes add them, RayHitIds::segment) and its face `face` (0 for an
+  /// analytic shape). false (th untouched) where this scene has no such primitive.
+  bool NameHit(int geom, int segment, int face, TraceHit* th) const;
 
   const SceneDescription& scene() const { return scene_; }
   const std::vector<BvhWideNode>& nodes() const { return nodes_; }
@@ -127,6 +134,13 @@ class BvhScene {
   std::vector<Record> records_;
   std::vector<int> record_group_;  // group of each record
   std::vector<Pose> X_GI_;         // by record: its group frame to its geom frame
+  // NameHit's tables: by record its first primitive in the order they were added (the input
+  // order: a geom's faces in turn), by input index its place in prims_, by geom its record
+  // (-1: not traced) and by group its instance (-1: none)
+  std::vector<int32_t> record_first_input_;
+  std::vector<int32_t> prim_of_input_;
+  std::vector<int32_t> record_of_geom_;
+  std::vector<int32_t> instance_of_group_;
   int64_t geometry_version_ = 0;
   double build_seconds_ = 0;
   int tendon_group_ = -1;                                // index into groups_, -1 without tendons
