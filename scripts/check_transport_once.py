@@ -44,11 +44,7 @@ DEFINITION_RE = re.compile(
     r"(?:[A-Za-z_][\w:]*(?:\s*<[^;{}()]*>)?[\s\*&]+)+?([A-Za-z_]\w*)\s*\(([^;{}]*)\)\s*"
     r"(?:const\s*)?(?:noexcept\s*)?(?:->\s*[\w:<>,\s\*&]+)?\{")
 # (file under src/penumbra, function) -> why it is still there
-KNOWN = {
-    ("render/cpu/mirror_layer.cc", "ApplyMirrorLayer"):
-        "the realtime tier's CPU chain (16-wide lanes over Embree packets) is not yet written "
-        "over render/transport; the scalar chain on the CPU measured 5-9x slower (docs/journal/2026-11-29-transport-design.md)",
-}
+KNOWN = {}
 KEYWORDS = {"if", "for", "while", "switch", "return", "sizeof", "catch", "do", "else", "case"}
 
 

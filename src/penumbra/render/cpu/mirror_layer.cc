@@ -1,26 +1,20 @@
 #include "penumbra/render/cpu/mirror_layer.h"
 
-#include <algorithm>
-#include <cmath>
 #include <vector>
 
-#include "penumbra/render/light/brdf_math.h"
 #include "penumbra/render/light/bsdf.h"
 #include "penumbra/render/media/media_common.h"
+#include "penumbra/render/transport/realtime_mirror.h"
 
 namespace penumbra {
 namespace {
 
-// the split-sum ambient specular fit (render/light/brdf_math.h) for one shading point.
-Eigen::Vector3f EnvBrdfApproxScalar(const Eigen::Vector3f& f0, float n_v, float roughness) {
-  const Float3 s = EnvBrdfApprox<float, Float3>(Float3{f0.x(), f0.y(), f0.z()}, n_v, roughness);
-  return Eigen::Vector3f(s.x, s.y, s.z);
-}
+Float3 ToF3Of(const Eigen::Vector3f& v) { return Float3{v.x(), v.y(), v.z()}; }
 
 }  // namespace
 
 Eigen::Vector3f MirrorRadiance(const FrameContext& ctx, const Ray& ray, float path_m, float wetness,
-                               uint64_t stream, uint64_t first_draw, int64_t* traced) {
+                               uint64_t stream, int64_t* traced) {
   SurfaceHit h;
   ++*traced;
   const Eigen::Vector3f d = ray.d.normalized();
@@ -30,51 +24,49 @@ Eigen::Vector3f MirrorRadiance(const FrameContext& ctx, const Ray& ray, float pa
       ConeFootprint(ctx.camera->pixel_spread_rad(), path_m + h.t * ray.d.norm(), d, h);
   SurfaceMaterial mat = ctx.materials->EvaluateAndMapNormal(&h, footprint);
   if (wetness > 0) ApplySurfaceWetness(wetness, h.ns_W, &mat.pbr);
-  const Bsdf bsdf(mat.pbr, h.ns_W, h.ng_W, wo);
-  const Eigen::Vector3f& n = bsdf.shading_normal();
+  // the hit as the transport's shading point (render/transport/realtime_mirror.h).
+  cuda::ShadingPoint sp;
+  const Eigen::Vector3f n = UsableShadingNormal(h.ns_W, h.ng_W, wo);
+  sp.p = ToF3Of(h.p_W);
+  sp.ng = ToF3Of(h.ng_W);
+  sp.n = ToF3Of(n);
+  sp.wo = ToF3Of(wo);
+  sp.base = ToF3Of(mat.pbr.base_color);
+  sp.emission = ToF3Of(mat.emission);
+  sp.roughness = mat.pbr.roughness;
+  sp.metallic = mat.pbr.metallic;
+  sp.specular = mat.pbr.specular;
+  sp.occlusion = mat.occlusion;
   const Eigen::Vector3f sky_E = ctx.sky_volume != nullptr
                                     ? ctx.sky_volume->Irradiance(h.p_W, n, *ctx.sky)
                                     : ctx.sky->Irradiance(n);
-  const Eigen::Vector3f spec = EnvBrdfApproxScalar(bsdf.f0(), std::max(n.dot(wo), 0.0f),
-                                                   std::clamp(mat.pbr.roughness, 0.0f, 1.0f));
-  const Eigen::Vector3f reflect =
-      bsdf.diffuse_color().cwiseProduct(Eigen::Vector3f::Ones() - spec) + spec;
-  Eigen::Vector3f L = mat.emission + (sky_E * (pbm::kInvPi * mat.occlusion)).cwiseProduct(reflect);
-  const Eigen::Vector3f origin = OffsetRayOrigin(h.p_W, h.ng_W);
   const bool shadows = ctx.ablation == nullptr || ctx.ablation->shadows;
-  for (int j = 0; j < ctx.lights->size(); ++j) {
-    float u1, u2;
-    Rng::Uniform2Of(Rng::DrawAt(stream, first_draw + j), &u1, &u2);
-    LightSample s;
-    if (!ctx.lights->Sample(j, h.p_W, u1, u2, &s)) continue;
-    const Eigen::Vector3f c = bsdf.Eval(s.wi).cwiseProduct(s.E);
-    if (!(c.maxCoeff() > 0)) continue;
-    if (s.cast_shadow && shadows) {
-      Ray sr;
-      sr.o = origin;
-      sr.d = s.wi;
-      sr.tmax = s.distance * (1.0f - 1e-4f);  // +inf stays +inf
-      // a sun ray that a static box provably blocks is occluded without tracing it.
-      if (ctx.sun_occluders != nullptr && j == ctx.sun_occluders->light_index() &&
-          ctx.sun_occluders->Blocks(sr.o, sr.d))
-        continue;
-      ++*traced;
-      if (ctx.scene->Occluded(sr)) continue;
-    }
-    L += c;
-  }
-  return L;
+  // the shadow rays through Embree; a sun ray that a static box provably blocks is occluded
+  // without tracing it.
+  auto occluded = [&](int j, const cuda::TraceRay& r) {
+    Ray sr;
+    sr.o = Eigen::Vector3f(r.o.x, r.o.y, r.o.z);
+    sr.d = Eigen::Vector3f(r.d.x, r.d.y, r.d.z);
+    sr.tmax = r.tmax;
+    if (ctx.sun_occluders != nullptr && j == ctx.sun_occluders->light_index() &&
+        ctx.sun_occluders->Blocks(sr.o, sr.d))
+      return true;
+    ++*traced;
+    return ctx.scene->Occluded(sr);
+  };
+  const Float3 L = cuda::MirrorHitRadiance(sp, ToF3Of(sky_E), ctx.lights->pods().data(),
+                                           ctx.lights->size(), stream, shadows, occluded);
+  return Eigen::Vector3f(L.x, L.y, L.z);
 }
 
-int64_t ApplyMirrorLayer(const FrameContext& ctx, const PrimaryHits& primary, const float* mirror,
-                         float wetness, const FrameBuffers& out) {
+int64_t ShadeMirrorLayerTile(const FrameContext& ctx, const PrimaryHits& primary,
+                             const float* mirror, float wetness, const FrameBuffers& out) {
   const PixelTile& tile = primary.tile;
   const int w = tile.width, n = tile.width * tile.height;
   const uint64_t frame_key = ctx.FrameKey();
   const uint64_t width = static_cast<uint64_t>(ctx.camera->width());
-  const uint64_t first_draw = static_cast<uint64_t>(ctx.lights->size());
   const bool sparse_on = ctx.ablation == nullptr || ctx.ablation->mirror_sparse;
-  thread_local std::vector<Eigen::Vector3f> Lm;
+  thread_local std::vector<Float3> Lm;
   thread_local std::vector<char> traced_here;
   Lm.resize(n);
   traced_here.assign(n, 0);
@@ -83,13 +75,16 @@ int64_t ApplyMirrorLayer(const FrameContext& ctx, const PrimaryHits& primary, co
     const int u = tile.x0 + i % w, v = tile.y0 + i / w;
     const SurfaceHit& h = primary.hits[i];
     const Eigen::Vector3f d = primary.rays[i].d.normalized();
-    const Eigen::Vector3f wi = d - 2.0f * d.dot(h.ng_W) * h.ng_W;
+    const cuda::TraceRay r = cuda::MirroredRay(ToF3Of(d), ToF3Of(h.p_W), ToF3Of(h.ng_W));
+    Ray ray;
+    ray.o = Eigen::Vector3f(r.o.x, r.o.y, r.o.z);
+    ray.d = Eigen::Vector3f(r.d.x, r.d.y, r.d.z);
     const uint64_t stream = FrameContext::PixelStream(
         frame_key, static_cast<uint64_t>(v) * width + static_cast<uint64_t>(u), 0);
-    return MirrorRadiance(ctx, SpawnRay(h, wi), h.t * primary.rays[i].d.norm(), wetness, stream,
-                          first_draw, &traced);
+    return ToF3Of(
+        MirrorRadiance(ctx, ray, h.t * primary.rays[i].d.norm(), wetness, stream, &traced));
   };
-  // the grid step of pixel i's layer: 1 (every pixel), 2 or 4 (file comment).
+  // the grid step of pixel i's layer: 1 (every pixel), 2 or 4 (mirror_math.h).
   auto step = [&](int i) { return sparse_on ? MirrorGridStep(mirror[i]) : 1; };
   // the traced pixels: those on their layer's grid (tiles start at multiples of 16, so the
   // tile's grid is the image's).
@@ -101,37 +96,28 @@ int64_t ApplyMirrorLayer(const FrameContext& ctx, const PrimaryHits& primary, co
       traced_here[i] = 1;
     }
   }
-  // the others: bilinear over the traced grid pixels around them on the same face and grid.
+  // the others: the mean of the traced grid pixels around them on the same face and grid.
   for (int i = 0; i < n; ++i) {
     if (!(mirror[i] > 0) || traced_here[i]) continue;
-    const int x = i % w, y = i / w, s = step(i);
+    const int s = step(i);
     const SurfaceHit& h = primary.hits[i];
-    const int gx = x - x % s, gy = y - y % s;
-    const int xs[2] = {gx, gx + s}, ys[2] = {gy, gy + s};
-    const float wx[2] = {MirrorGridWeight(x % s, s, 0), MirrorGridWeight(x % s, s, 1)};
-    const float wy[2] = {MirrorGridWeight(y % s, s, 0), MirrorGridWeight(y % s, s, 1)};
-    Eigen::Vector3f acc = Eigen::Vector3f::Zero();
-    float wsum = 0;
-    for (int b = 0; b < 2; ++b) {
-      if (!(wy[b] > 0) || ys[b] >= tile.height) continue;
-      for (int a = 0; a < 2; ++a) {
-        if (!(wx[a] > 0) || xs[a] >= w) continue;
-        const int j = ys[b] * w + xs[a];
-        if (!traced_here[j] || !(mirror[j] > 0) || step(j) != s) continue;
-        const SurfaceHit& hj = primary.hits[j];
-        if (hj.geom != h.geom || hj.ng_W != h.ng_W) continue;
-        const float wgt = wx[a] * wy[b];
-        acc += wgt * Lm[j];
-        wsum += wgt;
-      }
-    }
-    Lm[i] = wsum > 0 ? Eigen::Vector3f(acc / wsum) : trace(i);
+    auto lends = [&](int x, int y) {
+      const int j = y * w + x;
+      return traced_here[j] && mirror[j] > 0 && step(j) == s && primary.hits[j].geom == h.geom &&
+             primary.hits[j].ng_W == h.ng_W;
+    };
+    int lx[4], ly[4];
+    float wgt[4];
+    const int count = cuda::MirrorGridLenders(i % w, i / w, s, w, tile.height, lends, lx, ly, wgt);
+    Lm[i] = count > 0
+                ? cuda::MirrorGridMean(count, wgt, [&](int k) { return Lm[ly[k] * w + lx[k]]; })
+                : trace(i);
   }
   for (int i = 0; i < n; ++i) {
     if (!(mirror[i] > 0)) continue;
     float* Lp = out.radiance->at(tile.x0 + i % w, tile.y0 + i / w);
-    const float r = mirror[i];
-    for (int c = 0; c < 3; ++c) Lp[c] = MirrorBlend(Lp[c], Lm[i][c], r);
+    const Float3 L = cuda::MirrorLayerBlend(Float3{Lp[0], Lp[1], Lp[2]}, Lm[i], mirror[i]);
+    Lp[0] = L.x, Lp[1] = L.y, Lp[2] = L.z;
   }
   return traced;
 }

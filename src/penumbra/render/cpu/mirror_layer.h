@@ -19,8 +19,10 @@
 // reflected contrast). the reflection's random numbers are as before (draws num_lights ... of
 // the traced pixel's stream), so the dense layer is bit-identical to the per-pixel one, and so
 // is the whole image of a scene without weak mirrors.
-// the grid, its weights and the blend are render/light/mirror_math.h's (shared with the CUDA
-// backend). RenderAblation::mirror_sparse = false traces every pixel (bench comparisons).
+// the arithmetic is the transport's (render/transport/realtime_mirror.h: MirroredRay,
+// MirrorHitRadiance, MirrorGridLenders, MirrorGridMean, MirrorLayerBlend), shared with the CUDA
+// backend; this file is the CPU's driver: the tile loop, Embree's rays and the CPU's surface
+// evaluation. RenderAblation::mirror_sparse = false traces every pixel (bench comparisons).
 //
 // determinism: per tile, independent of thread count and tile order.
 
@@ -32,18 +34,19 @@
 
 namespace penumbra {
 
-/// radiance arriving along the mirrored ray `ray` (see the file comment), its light samples'
-/// numbers from draws first_draw ... of the pixel's `stream`. one reflection: a mirror seen in
-/// a mirror shows its BRDF only. `path_m`: the camera-to-mirror distance (texture level of
+/// radiance arriving along the mirrored ray `ray` (see the file comment): the sky's
+/// Background where it escapes, else the transport's MirrorHitRadiance at the hit (its light
+/// samples' numbers from draws lights->size() ... of the pixel's `stream`; shadow rays through
+/// Embree and the sun-occluder map). `path_m`: the camera-to-mirror distance (texture level of
 /// detail); `wetness`: MediaFrame::surface_wetness; no media or particles along the ray. adds
 /// the rays it traces to *traced.
 Eigen::Vector3f MirrorRadiance(const FrameContext& ctx, const Ray& ray, float path_m, float wetness,
-                               uint64_t stream, uint64_t first_draw, int64_t* traced);
+                               uint64_t stream, int64_t* traced);
 
 /// applies the mirror layer to the hit pixels of primary.tile: out.radiance holds every
 /// pixel's radiance without the layer, mirror[i] the weight r of tile pixel i (row-major over
 /// the tile; 0 = no layer, also for pixels that see the sky). returns the rays it traced.
-int64_t ApplyMirrorLayer(const FrameContext& ctx, const PrimaryHits& primary, const float* mirror,
-                         float wetness, const FrameBuffers& out);
+int64_t ShadeMirrorLayerTile(const FrameContext& ctx, const PrimaryHits& primary,
+                             const float* mirror, float wetness, const FrameBuffers& out);
 
 }  // namespace penumbra

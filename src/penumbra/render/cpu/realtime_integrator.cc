@@ -1,5 +1,3 @@
-#include "penumbra/render/cpu/realtime_integrator.h"
-
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -10,6 +8,7 @@
 #include "penumbra/render/cpu/bsdf_lanes.h"
 #include "penumbra/render/cpu/light_lanes.h"
 #include "penumbra/render/cpu/mirror_layer.h"
+#include "penumbra/render/cpu/realtime_integrator.h"
 #include "penumbra/render/cpu/shadow_window_lanes.h"
 #include "penumbra/render/light/brdf_math.h"
 #include "penumbra/render/light/bsdf.h"
@@ -756,7 +755,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   // the shadowed light of lights with an extent, its visibility shared between neighbours.
   ResolveSharedVisibility(ctx, primary, scratch, out, &traced);
   // the mirror layer once every pixel holds its own radiance (render/cpu/mirror_layer.h).
-  if (any_mirror) traced += ApplyMirrorLayer(ctx, primary, scratch.mirror.data(), wetness, out);
+  if (any_mirror) traced += ShadeMirrorLayerTile(ctx, primary, scratch.mirror.data(), wetness, out);
   // the effects once every pixel of the tile holds its surface or sky radiance.
   if (fx != nullptr) ApplyTileViewEffects(ctx, primary, out);
   return traced;
