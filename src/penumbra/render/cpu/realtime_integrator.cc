@@ -16,6 +16,7 @@
 #include "penumbra/render/light/shadow_window_math.h"
 #include "penumbra/render/media/media_common.h"
 #include "penumbra/render/particles/particle_math.h"
+#include "penumbra/render/transport/realtime_visibility.h"
 
 namespace penumbra {
 namespace {
@@ -137,6 +138,7 @@ Vec3Lanes ExtendedLightContribution(const ExtendedAxisLanes& a, const BsdfLanes&
 void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary,
                              const Scratch& scratch, const FrameBuffers& out, int64_t* traced) {
   const PixelTile& tile = primary.tile;
+  const ShadowTile shadow_tile{tile.x0, tile.y0, tile.width, tile.height};
   const int n = tile.width * tile.height;
   const int num_lights = ctx.lights->size();
   thread_local std::vector<float> visible, rays, fraction;
@@ -211,16 +213,6 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
         v |= static_cast<uint32_t>(b == 1) << x;
       }
       rows_occluded[y] = o, rows_visible[y] = v, rows_more[y] = 0;
-    }
-  };
-  // calls fn(ii, weight) for the pixels of i's window on i's surface with a verdict.
-  auto for_window = [&](const int8_t* vis, int i, auto&& fn) {
-    for (uint32_t bits = near[i]; bits != 0; bits &= bits - 1) {
-      const int b = LowestSetBit(bits);
-      const int dy = b / 5 - 2, dx = b % 5 - 2;
-      const int ii = i + dy * tile.width + dx;
-      if (vis[ii] < 0) continue;
-      fn(ii, ShadowWindowWeight(dx, dy));
     }
   };
 
@@ -303,11 +295,11 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
       const int x = xs[i], y = ys[i];
       const int first = first_point(i);
       const float share = pbm::Luminance709(c[i].x(), c[i].y(), c[i].z()) / scratch.total[i];
-      const int points = PenumbraLatticePoints(share);
-      own[i] = OnShadowTileRing(x, y, ShadowTile{tile.x0, tile.y0, tile.width, tile.height});
-      const int extra = own[i] ? points : std::max(1, points / kLightStrata);
+      own[i] = OnShadowTileRing(x, y, shadow_tile);
+      int points;
+      const int extra = cuda::PenumbraExtraRays(share, own[i] != 0, &points);
       for (int r = 1; r < extra; ++r)
-        trace_point(i, own[i] ? PenumbraLatticeIndex(first, r, points) : first + r);
+        trace_point(i, cuda::PenumbraPointIndex(first, r, points, own[i] != 0));
       if (extra > 1) rows_more[y] |= 1u << x;
     }
     flush();
@@ -320,10 +312,17 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
       if (fraction[i] == 1.0f) rows_lit[ys[i]] |= bit;
       if (fraction[i] == 0.0f) rows_dark[ys[i]] |= bit;
     };
+    // the tile's arrays as the transport's taps (stride: the tile's width).
+    cuda::VisibilityTaps taps;
+    taps.vis = vis;
+    taps.visible = visible.data();
+    taps.rays = rays.data();
+    taps.fraction = fraction.data();
+    taps.stride = tile.width;
     for (int i = 0; i < n; ++i) {
       if (vis[i] < 0) continue;
       if (own[i]) {
-        fraction[i] = visible[i] / rays[i];
+        fraction[i] = cuda::SharedWindowFraction(taps, i, near[i], true);
         note_fraction(i);
         continue;
       }
@@ -333,12 +332,7 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
         note_fraction(i);
         continue;
       }
-      float w_rays = 0, w_visible = 0;
-      for_window(vis, i, [&](int ii, float w) {
-        w_rays += w * rays[ii];
-        w_visible += w * visible[ii];
-      });
-      fraction[i] = w_visible / w_rays;
+      fraction[i] = cuda::SharedWindowFraction(taps, i, near[i], false);
       note_fraction(i);
     }
     // a lamp's penumbrae (tens of pixels wide next to its fixture) once more over the 3x3
@@ -359,21 +353,14 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
         } else if ((nb & ~window_bits(rows_dark.data(), x, y)) == 0) {
           V = 0.0f;
         } else {
-          float sum = 0;
-          int count = 0;
-          for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, tile.height - 1); ++yy)
-            for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, tile.width - 1); ++xx) {
-              const int ii = yy * tile.width + xx;
-              if (vis[ii] < 0 || (near[i] >> ((yy - y + 2) * 5 + xx - x + 2) & 1u) == 0) continue;
-              sum += fraction[ii];
-              ++count;
-            }
-          V = sum / static_cast<float>(count);
+          V = cuda::SharedLampFraction(taps, i, near[i], true, x, y, shadow_tile);
         }
       }
       if (!(V > 0)) continue;
       float* Lp = out.radiance->at(tile.x0 + x, tile.y0 + y);
-      Lp[0] += V * c[i].x(), Lp[1] += V * c[i].y(), Lp[2] += V * c[i].z();
+      const Float3 L = cuda::AddSharedVisibility(Float3{Lp[0], Lp[1], Lp[2]}, V,
+                                                 Float3{c[i].x(), c[i].y(), c[i].z()});
+      Lp[0] = L.x, Lp[1] = L.y, Lp[2] = L.z;
     }
   }
 }

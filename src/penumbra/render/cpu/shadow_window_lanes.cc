@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "penumbra/render/light/shadow_window_math.h"
+#include "penumbra/render/transport/realtime_visibility.h"
 
 #if defined(__AVX512F__)
 #include <immintrin.h>
@@ -10,27 +11,28 @@
 
 namespace penumbra {
 
+namespace {
+
+// a tile's hits as the transport's window masks read them (cuda::ShadowWindowMask's Surfaces).
+struct TileHitSurfaces {
+  const bool* did_hit;
+  const int* geom;
+  const float *p, *n;
+  bool Hit(int64_t k) const { return did_hit[k]; }
+  int Geom(int64_t k) const { return geom[k]; }
+  void Surface(int64_t k, float ng[3], float pk[3]) const {
+    for (int a = 0; a < 3; ++a) ng[a] = n[3 * k + a], pk[a] = p[3 * k + a];
+  }
+};
+
+}  // namespace
+
 void SameSurfaceWindows(int width, int height, const bool* did_hit, const int* geom, const float* p,
                         const float* n, uint32_t* near) {
-  for (int y = 0, i = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x, ++i) {
-      near[i] = 0;
-      if (!did_hit[i]) continue;
-      uint32_t bits = 1u << ShadowWindowBit(0, 0);
-      for (int dy = -2; dy <= 2; ++dy) {
-        if (y + dy < 0 || y + dy >= height) continue;
-        for (int dx = -2; dx <= 2; ++dx) {
-          if (x + dx < 0 || x + dx >= width) continue;
-          const int ii = i + dy * width + dx;
-          if (ii == i || geom[ii] != geom[i] ||
-              !SameShadowSurface(geom[i], &n[3 * i], &p[3 * i], geom[ii], &n[3 * ii], &p[3 * ii]))
-            continue;
-          bits |= 1u << ShadowWindowBit(dx, dy);
-        }
-      }
-      near[i] = bits;
-    }
-  }
+  const TileHitSurfaces s{did_hit, geom, p, n};
+  const ShadowTile tile{0, 0, width, height};
+  for (int y = 0, i = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x, ++i) near[i] = cuda::ShadowWindowMask(s, i, width, x, y, tile);
 }
 
 void SameSurfaceWindowsLanes(int width, int height, const bool* did_hit, const int* geom,

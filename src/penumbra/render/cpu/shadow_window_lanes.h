@@ -2,7 +2,8 @@
 // the same-surface masks of the shared shadow visibility (realtime_integrator.cc,
 // ResolveSharedVisibility): per pixel of a tile, which pixels of its 5x5 window lie on its
 // surface (SameShadowSurface, render/light/shadow_window_math.h). SameSurfaceWindows is the scalar
-// definition; SameSurfaceWindowsLanes computes the same masks with a tile row's pixels as SIMD
+// definition, the transport's ShadowWindowMask (render/transport/realtime_visibility.h) per pixel;
+// SameSurfaceWindowsLanes computes the same masks with a tile row's pixels as SIMD
 // lanes (AVX-512: 16 pixels per register, one window offset at a time), bit for bit (the same
 // float operations per pixel pair, in the shared formula's order; without AVX-512 it is the
 // scalar loop).

@@ -2,8 +2,12 @@
 // the realtime tier's shared visibility of lights with an extent (lamp spheres, the sun's disc):
 // each pixel's penumbra rays, the ratio estimator over its 5x5 same-surface window cut at the
 // 16x16 tiles' edges and the resolve into the pixel's radiance (SharedVisibilityRays, Fraction,
-// Resolve after ShadeRealtimePixel), as render/light/shadow_window_math.h and the CPU's
-// shadow_window_lanes.cc.
+// Resolve after ShadeRealtimePixel) over render/light/shadow_window_math.h. the per-pixel
+// arithmetic is written once: the window masks (ShadowWindowMask), the penumbra rays' count and
+// lattice points (PenumbraExtraRays, PenumbraPointIndex), the window's fraction
+// (SharedWindowFraction), a lamp's 3x3 mean (SharedLampFraction) and the resolve
+// (AddSharedVisibility); the CPU's ResolveSharedVisibility (render/cpu/realtime_integrator.cc)
+// drives them per 16x16 tile over its own arrays, its penumbra rays as Embree packets.
 
 #include <cstdint>
 
@@ -15,6 +19,24 @@
 #include "penumbra/render/transport/scene_view.h"
 
 namespace penumbra::cuda {
+
+/// the penumbra rays of a pixel whose window sees both verdicts towards a light with an extent:
+/// *points = PenumbraLatticePoints(share) (share: the light's part of the pixel's unshadowed
+/// luminance); returns `extra`, the rays r = 1 .. extra - 1 it traces after its first: on a
+/// tile's outer ring (`own`: its window lacks the next tile's half) `points` points of its
+/// own, else max(1, points / kLightStrata) (a window of 16 pixels then averages `points`).
+PB_HOST_DEVICE inline int PenumbraExtraRays(float share, bool own, int* points) {
+  *points = PenumbraLatticePoints(share);
+  const int shared = *points / kLightStrata > 1 ? *points / kLightStrata : 1;
+  return own ? *points : shared;
+}
+
+/// the index in the kLightStrata kLightPenumbraRays lattice (LightStratumUniforms) of penumbra
+/// ray r of a pixel whose first point is `first` (kLightPenumbraRays LightStratum(u, v)):
+/// PenumbraLatticeIndex of its `points` own points where `own`, else first + r.
+PB_HOST_DEVICE inline int PenumbraPointIndex(int first, int r, int points, bool own) {
+  return own ? PenumbraLatticeIndex(first, r, points) : first + r;
+}
 
 /// one light's penumbra rays at one pixel (SharedVisibilityRays): the pixel's own verdict and
 /// the lattice points of its extra shadow rays r = 1 .. extra - 1.
@@ -185,14 +207,14 @@ PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbraOf(const RealtimeFram
   const bool own = OnShadowTileRing(u - tile.x0, v - tile.y0, tile);
   f.area_own[k] = own ? 1 : 0;
   const Float3 c = f.area_c[k];
-  const int points = PenumbraLatticePoints(pbm::Luminance709(c.x, c.y, c.z) / f.total[i]);
-  const int shared = points / kLightStrata > 1 ? points / kLightStrata : 1;
+  int points;
+  const int extra = PenumbraExtraRays(pbm::Luminance709(c.x, c.y, c.z) / f.total[i], own, &points);
   const PixelGeometry& gi = f.geometry[i];
   job.p = gi.p_or_d;
   job.ng = gi.ng;
   job.first = kLightPenumbraRays * LightStratum(u, v);
   job.points = points;
-  job.extra = own ? points : shared;
+  job.extra = extra;
   job.own = own ? 1 : 0;
   return job;
 }
@@ -217,9 +239,7 @@ PB_HOST_DEVICE inline int PenumbraRayVerdict(const RealtimeFrameView& f, int j,
   float u1, u2, d_r;
   Float3 w_r, E_r;
   bool ok;
-  LightStratumUniforms(
-      job.own != 0 ? PenumbraLatticeIndex(job.first, r, job.points) : job.first + r, kAll, &u1,
-      &u2);
+  LightStratumUniforms(PenumbraPointIndex(job.first, r, job.points, job.own != 0), kAll, &u1, &u2);
   SampleLight<float, Float3, bool>(f.lights[j], job.p, u1, u2, &w_r, &d_r, &E_r, &ok);
   if (!ok || !(pbm::Dot<float>(w_r, job.ng) > 0)) return -1;
   TraceRay sr;
