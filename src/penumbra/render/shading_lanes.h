@@ -251,6 +251,23 @@ inline Lanes StepGreaterEqual(const Lanes& x, float e) {
   return s;
 }
 inline LaneMask GreaterThan(const Lanes& a, float b) { return penumbra::GreaterThan(a, b); }
+inline LaneMask GreaterThan(const Lanes& a, const Lanes& b) { return penumbra::GreaterThan(a, b); }
+inline LaneMask GreaterEqual(const Lanes& a, const Lanes& b) {
+  return penumbra::GreaterEqual(a, b);
+}
+inline Lanes StepGreaterThan(const Lanes& x, float e) {
+  return (x > e).select(Lanes::Ones(), Lanes::Zero());
+}
+inline Lanes WherePositiveElse(const Lanes& c, const Lanes& a, float b) {
+  return (c > 0.0f).select(a, b);
+}
+inline Lanes Where(const LaneMask& m, const Lanes& a) { return penumbra::Where(m, a); }
+inline float& LaneOf(Lanes& x, int k) { return x[k]; }
+inline float LaneOf(const Lanes& x, int k) { return x[k]; }
+template <typename F>
+inline void ForEachLane(const LaneMask& m, F&& fn) {
+  for (uint32_t bits = m.bits(); bits != 0; bits &= bits - 1) fn(std::countr_zero(bits));
+}
 template <>
 inline Lanes Splat<Lanes>(float x) {
   return Lanes::Constant(x);

@@ -83,6 +83,25 @@ PB_HOST_DEVICE inline float WhereAllPositive(float c0, float c1, float c2, float
 PB_HOST_DEVICE inline float StepGreaterEqual(float x, float e) { return x >= e ? 1.0f : 0.0f; }
 /// a > b (LaneMask for lanes).
 PB_HOST_DEVICE inline bool GreaterThan(float a, float b) { return a > b; }
+/// a >= b (LaneMask for lanes).
+PB_HOST_DEVICE inline bool GreaterEqual(float a, float b) { return a >= b; }
+/// x > e ? 1 : 0.
+PB_HOST_DEVICE inline float StepGreaterThan(float x, float e) { return x > e ? 1.0f : 0.0f; }
+/// c > 0 ? a : b.
+PB_HOST_DEVICE inline float WherePositiveElse(float c, float a, float b) {
+  return c > 0.0f ? a : b;
+}
+/// m ? a : +0 (the lanes' Where: +0 in unselected lanes).
+PB_HOST_DEVICE inline float Where(bool m, float a) { return m ? a : 0.0f; }
+/// lane k of x (a float has one lane, k = 0).
+PB_HOST_DEVICE inline float& LaneOf(float& x, int) { return x; }
+PB_HOST_DEVICE inline float LaneOf(const float& x, int) { return x; }
+/// calls fn(k) for every lane k set in m (a bool: fn(0) where true), lowest lane first: the
+/// scalar work a formula does on a few lanes (a light straddling the horizon).
+template <typename F>
+PB_HOST_DEVICE inline void ForEachLane(bool m, F&& fn) {
+  if (m) fn(0);
+}
 /// a value of type T with every lane x (float: x).
 template <typename T>
 PB_HOST_DEVICE inline T Splat(float x);

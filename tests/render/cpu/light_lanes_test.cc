@@ -1,9 +1,8 @@
-// the lane form of the horizon test of lights with an extent (LightStraddlesHorizonLanes)
-// agrees with the scalar definition (LightStraddlesHorizon) lane by lane: random cosines and
+// the lane instantiation of the horizon test of lights with an extent
+// (LightStraddlesHorizonOf<Lanes, LaneMask>) agrees with the scalar one (LightStraddlesHorizon)
+// lane by lane: random cosines and
 // angular radii, the boundary cases cos^2 == sin^2 and cos == sin sigma, points (sin^2 = 0),
 // negative, infinite and NaN inputs.
-
-#include "penumbra/render/cpu/light_lanes.h"
 
 #include <gtest/gtest.h>
 
@@ -13,6 +12,7 @@
 
 #include "penumbra/core/rng.h"
 #include "penumbra/render/light/lamp_math.h"
+#include "penumbra/render/shading_lanes.h"
 
 namespace penumbra {
 namespace {
@@ -58,7 +58,7 @@ TEST(LightLanesTest, StraddlesHorizonLanesEqualsTheScalarTest) {
       }
       cos_t[k] = c, sin2[k] = s2, sin_sigma[k] = ss;
     }
-    const LaneMask lanes = LightStraddlesHorizonLanes(cos_t, sin2, sin_sigma);
+    const LaneMask lanes = LightStraddlesHorizonOf<Lanes, LaneMask>(cos_t, sin2, sin_sigma);
     for (int k = 0; k < kLanes; ++k) {
       const bool scalar = LightStraddlesHorizon(cos_t[k], sin2[k], sin_sigma[k]);
       ASSERT_EQ(lanes[k], scalar) << "cos " << cos_t[k] << " sin^2 " << sin2[k] << " sin "

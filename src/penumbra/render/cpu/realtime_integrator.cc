@@ -1,3 +1,5 @@
+#include "penumbra/render/cpu/realtime_integrator.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -6,9 +8,7 @@
 #include <vector>
 
 #include "penumbra/render/cpu/bsdf_lanes.h"
-#include "penumbra/render/cpu/light_lanes.h"
 #include "penumbra/render/cpu/mirror_layer.h"
-#include "penumbra/render/cpu/realtime_integrator.h"
 #include "penumbra/render/cpu/shadow_window_lanes.h"
 #include "penumbra/render/light/brdf_math.h"
 #include "penumbra/render/light/bsdf.h"
@@ -45,81 +45,11 @@ struct Scratch {
 constexpr int kPenumbraRays = kLightPenumbraRays;
 
 // a light with an extent: a sphere lamp (radius > 0) or the sun's disc. its unshadowed light is
-// analytic (render/light/lamp_math.h) and its visibility shared over 5x5 pixels.
-bool IsExtendedLight(const PosedLight& l) {
-  return HasLightExtent(l.type == Light::Type::kDirectional, l.cos_angular_radius, l.radius_m);
-}
-
-// where extended light `l` lies seen from every lane's point p: the unit axis w towards its
-// centre, sin^2 sigma of its angular radius, the distance to its near surface (SphereLightAxis's
-// arithmetic), cos_t = n . w on the shading normal and sin sigma; the lanes where the light
-// straddles the horizon (render/cpu/light_lanes.h), and those it may reach: above the horizon
-// (cos_t > 1e-6) or straddling it. a lane outside `reaches` gets exactly 0 from
-// ExtendedLightContribution (scale 0 times a finite BRDF and illuminance).
-struct ExtendedAxisLanes {
-  Vec3Lanes w;
-  Lanes sin2, dist_near, cos_t, sin_sigma;
-  LaneMask straddles, reaches;
-};
-ExtendedAxisLanes ExtendedLightAxis(const PosedLight& l, const Vec3Lanes& p,
-                                    const BsdfLanes& bsdf) {
-  ExtendedAxisLanes a;
-  Vec3Lanes& w = a.w;
-  Lanes &sin2 = a.sin2, &dist_near = a.dist_near;
-  if (l.type == Light::Type::kDirectional) {
-    w = {Lanes::Constant(-l.direction_W.x()), Lanes::Constant(-l.direction_W.y()),
-         Lanes::Constant(-l.direction_W.z())};
-    sin2 = Lanes::Constant(1.0f - l.cos_angular_radius * l.cos_angular_radius);
-    dist_near = Lanes::Constant(std::numeric_limits<float>::infinity());
-  } else {
-    const Vec3Lanes t{l.position_W.x() - p.x, l.position_W.y() - p.y, l.position_W.z() - p.z};
-    const Lanes d2 = t.Dot(t);
-    const Lanes d = d2.sqrt();
-    const Lanes inv = (d > 0.0f).select(1.0f / d, 0.0f);
-    w = {t.x * inv, t.y * inv, t.z * inv};
-    sin2 = (d2 > 0.0f).select((l.radius_m * l.radius_m / d2).min(1.0f), 1.0f);
-    dist_near = (d - l.radius_m).max(0.0f);
-  }
-  a.cos_t = bsdf.n.Dot(w);
-  a.sin_sigma = sin2.max(0.0f).sqrt();
-  a.straddles = LightStraddlesHorizonLanes(a.cos_t, sin2, a.sin_sigma);
-  a.reaches = GreaterThan(a.cos_t, 1e-6f) || a.straddles;
-  return a;
-}
-
-// the unshadowed contribution f(wo, wi) E_i of extended light `l` with axis `a`
-// (ExtendedLightAxis), sampled as `s` (stratum direction, illuminance I / d^2 or E_sun), for
-// every lane in `on`: the BRDF at the direction to the light's centre (tilted above the horizon
-// where the light straddles it) times the horizon-clipped illuminance of the sphere or disc
-// (SphereLightCosine). lanes whose stratum direction is below the geometric surface get that
-// tilted direction for their shadow ray (written to s->wi, s->distance).
-Vec3Lanes ExtendedLightContribution(const ExtendedAxisLanes& a, const BsdfLanes& bsdf,
-                                    const LaneMask& on, LightSampleLanes* s) {
-  const Vec3Lanes& w = a.w;
-  const Lanes &sin2 = a.sin2, &dist_near = a.dist_near, &cos_t = a.cos_t;
-  // wholly above or below the horizon: wi = w, factor 1 above (ExtendedLightShading exactly);
-  // a light straddling it (few lanes; render/cpu/light_lanes.h) goes through
-  // ExtendedLightShading.
-  Vec3Lanes wi_rep = w;
-  Lanes scale = Where(on, (cos_t > 1e-6f).select(Lanes::Ones(), Lanes::Zero()));
-  for (uint32_t bits = (on && a.straddles).bits(); bits != 0; bits &= bits - 1) {
-    const int k = std::countr_zero(bits);
-    const float wk[3] = {w.x[k], w.y[k], w.z[k]};
-    const float n[3] = {bsdf.n.x[k], bsdf.n.y[k], bsdf.n.z[k]};
-    float r[3];
-    scale[k] = ExtendedLightShading(wk, sin2[k], n, r);
-    wi_rep.x[k] = r[0], wi_rep.y[k] = r[1], wi_rep.z[k] = r[2];
-  }
-  // the shadow ray: the lane's lattice point, or the shading direction where that point lies
-  // below the geometric surface (it would test the surface itself, not the occluders).
-  const LaneMask below = !GreaterThan(bsdf.ng.Dot(s->wi), 0.0f);
-  for (uint32_t bits = below.bits(); bits != 0; bits &= bits - 1) {
-    const int k = std::countr_zero(bits);
-    s->wi.x[k] = wi_rep.x[k], s->wi.y[k] = wi_rep.y[k], s->wi.z[k] = wi_rep.z[k];
-    s->distance[k] = dist_near[k];
-  }
-  const Vec3Lanes f = bsdf.Eval(wi_rep);
-  return Where(on, Vec3Lanes{f.x * s->E.x * scale, f.y * s->E.y * scale, f.z * s->E.z * scale});
+// analytic (render/light/lamp_math.h; the transport's ExtendedLightAxisOf and
+// ExtendedLightContribution, render/transport/realtime_shading.h) and its visibility shared over
+// 5x5 pixels.
+bool IsExtendedLight(const FrameContext& ctx, int j) {
+  return cuda::IsExtendedLightPod(ctx.lights->pods()[j]);
 }
 
 // adds the extended lights' contributions of a tile to its radiance: pixel i's light j counts
@@ -156,7 +86,7 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
   mixed.resize(n);
   seen_visible.resize(n);
   bool any = false;
-  for (int j = 0; j < num_lights; ++j) any = any || IsExtendedLight(ctx.lights->lights()[j]);
+  for (int j = 0; j < num_lights; ++j) any = any || IsExtendedLight(ctx, j);
   if (!any) return;
   // every pixel's column and row in the tile.
   thread_local std::vector<uint8_t> xs, ys;
@@ -217,7 +147,7 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
   };
 
   for (int j = 0; j < num_lights; ++j) {
-    if (!IsExtendedLight(ctx.lights->lights()[j])) continue;
+    if (!IsExtendedLight(ctx, j)) continue;
     const int8_t* vis = &scratch.area_vis[static_cast<size_t>(j) * n];
     const Eigen::Vector3f* c = &scratch.area_c[static_cast<size_t>(j) * n];
     // the shadow rays through further lattice points, kLanes at a time: their directions as
@@ -652,11 +582,11 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     for (int j = 0; j < num_lights; ++j) {
       LightSampleLanes& s = scratch.samples[j];
       Vec3Lanes& c = scratch.contrib[j];
-      const PosedLight& light = ctx.lights->lights()[j];
-      const bool extended = IsExtendedLight(light);
-      ExtendedAxisLanes axis;
+      const LightPod& light = ctx.lights->pods()[j];
+      const bool extended = cuda::IsExtendedLightPod(light);
+      cuda::ExtendedLightAxis<Lanes, Vec3Lanes, LaneMask> axis;
       if (extended) {
-        axis = ExtendedLightAxis(light, p, bsdf);
+        axis = cuda::ExtendedLightAxisOf<Lanes, Vec3Lanes, LaneMask>(light, p, bsdf.n);
         // every hit lane below the light's horizon (e.g. a run of a wall facing away from a
         // lamp): the contribution is exactly 0 in every lane, so the light's sample, BRDF and
         // media terms are skipped (nothing reads them where c is 0) and the total stays as it is.
@@ -667,11 +597,13 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       }
       ctx.lights->SampleLanes(j, p, stratum_u1, stratum_u2, &s);
       const LaneMask on = hit && s.valid;
+      // the transport's arithmetic (render/transport/realtime_shading.h), over the lanes.
       if (extended) {
-        c = ExtendedLightContribution(axis, bsdf, on, &s);
+        c = cuda::ExtendedLightContribution(axis, bsdf.n, bsdf.ng, bsdf.wo, bsdf.n_v, bsdf.c_diff,
+                                            bsdf.f0, bsdf.a2, on, s.E, &s.wi, &s.distance);
       } else {
-        const Vec3Lanes f = bsdf.Eval(s.wi);
-        c = Where(on, Vec3Lanes{f.x * s.E.x, f.y * s.E.y, f.z * s.E.z});
+        c = cuda::PointLightContribution<Lanes, Vec3Lanes, LaneMask>(
+            bsdf.n, bsdf.ng, bsdf.wo, bsdf.n_v, bsdf.c_diff, bsdf.f0, bsdf.a2, on, s.E, s.wi);
       }
       if (rm != nullptr) {
         // attenuation of the light by the media between the surface and the light.
@@ -705,7 +637,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       L = L + Where(unshadowed, c);
       if (!shadowed.any()) continue;
       const LightSampleLanes& s = scratch.samples[j];
-      const bool extended = IsExtendedLight(ctx.lights->lights()[j]);
+      const bool extended = IsExtendedLight(ctx, j);
       const Lanes tmax = s.distance * (1.0f - 1e-4f);  // +inf stays +inf
       // the sun's rays that a static box provably blocks are occluded without tracing them.
       const LaneMask skipped = ctx.sun_occluders != nullptr && j == ctx.sun_occluders->light_index()

@@ -29,6 +29,7 @@
 #include <cmath>
 
 #include "penumbra/core/host_device.h"
+#include "penumbra/render/shading_math.h"
 
 namespace penumbra {
 
@@ -117,8 +118,19 @@ PB_HOST_DEVICE inline bool HasLightExtent(bool directional, float cos_angular_ra
 /// it (else it lies wholly above, factor 1, or wholly below, factor 0). a point whose cos^2
 /// rounds to >= sin^2 sigma but cos to < sin sigma counts as straddling, as
 /// ExtendedLightShading would treat it.
+/// for a float (M bool) or every lane of Lanes (M LaneMask), by the same comparisons of the same
+/// values (a NaN straddles).
+template <typename T, typename M>
+PB_HOST_DEVICE inline M LightStraddlesHorizonOf(const T& cos_t, const T& sin2_sigma,
+                                                const T& sin_sigma) {
+  const T cos2 = cos_t * cos_t;
+  const M wholly = (pbm::GreaterEqual(cos2, sin2_sigma) || !pbm::GreaterThan(sin2_sigma, 0.0f)) &&
+                   !(pbm::GreaterThan(cos_t, 0.0f) && pbm::GreaterThan(sin_sigma, cos_t));
+  return !wholly;
+}
+/// LightStraddlesHorizonOf of one point.
 PB_HOST_DEVICE inline bool LightStraddlesHorizon(float cos_t, float sin2_sigma, float sin_sigma) {
-  return !((cos_t * cos_t >= sin2_sigma || !(sin2_sigma > 0)) && !(cos_t > 0 && cos_t < sin_sigma));
+  return LightStraddlesHorizonOf<float, bool>(cos_t, sin2_sigma, sin_sigma);
 }
 
 /// how a light of angular radius sigma around unit direction w is shaded at a point with unit

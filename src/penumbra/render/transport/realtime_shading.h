@@ -58,12 +58,98 @@ PB_HOST_DEVICE inline void PixelLatticeUniforms(int u, int v, int r, float* u1, 
                        kLightStrata * kLightPenumbraRays, u1, u2);
 }
 
+/// where a light with an extent (IsExtendedLightPod) lies seen from shading point(s) p with
+/// unit shading normal n, for a float (one point: the GPU) or Lanes (the CPU's kLanes points;
+/// V the 3-vector, M the mask of T): the unit axis w towards its centre, sin^2 sigma of its
+/// angular radius, the distance to its near surface (SphereLightAxis's arithmetic; the sun: +inf),
+/// cos_t = n . w and sin sigma; where it straddles the horizon (LightStraddlesHorizonOf), and
+/// where it may reach the point: above the horizon (cos_t > 1e-6) or straddling it (elsewhere
+/// ExtendedLightContribution is exactly 0: scale 0 times a finite BRDF and illuminance).
+template <typename T, typename V, typename M>
+struct ExtendedLightAxis {
+  V w;
+  T sin2, dist_near, cos_t, sin_sigma;
+  M straddles, reaches;
+};
+
+/// ExtendedLightAxis of light l at p (n: the unit shading normal).
+template <typename T, typename V, typename M>
+PB_HOST_DEVICE inline ExtendedLightAxis<T, V, M> ExtendedLightAxisOf(const LightPod& l, const V& p,
+                                                                     const V& n) {
+  ExtendedLightAxis<T, V, M> a;
+  if (l.kind == LightKind::kDirectional) {
+    a.w = V{pbm::Splat<T>(-l.direction_W.x), pbm::Splat<T>(-l.direction_W.y),
+            pbm::Splat<T>(-l.direction_W.z)};
+    a.sin2 = pbm::Splat<T>(1.0f - l.cos_angular_radius * l.cos_angular_radius);
+    a.dist_near = pbm::Splat<T>(INFINITY);
+  } else {
+    const V t{l.position_W.x - p.x, l.position_W.y - p.y, l.position_W.z - p.z};
+    const T d2 = pbm::Dot<T>(t, t);
+    const T d = pbm::Sqrt(d2);
+    const T inv = pbm::WherePositiveElse(d, T(1.0f / d), 0.0f);
+    a.w = V{t.x * inv, t.y * inv, t.z * inv};
+    const T r2_d2 = l.radius_m * l.radius_m / d2;
+    a.sin2 = pbm::WherePositiveElse(d2, pbm::Min(r2_d2, 1.0f), 1.0f);
+    a.dist_near = pbm::Max(T(d - l.radius_m), 0.0f);
+  }
+  a.cos_t = pbm::Dot<T>(n, a.w);
+  a.sin_sigma = pbm::Sqrt(pbm::Max(a.sin2, 0.0f));
+  a.straddles = LightStraddlesHorizonOf<T, M>(a.cos_t, a.sin2, a.sin_sigma);
+  a.reaches = pbm::GreaterThan(a.cos_t, 1e-6f) || a.straddles;
+  return a;
+}
+
+/// the unshadowed contribution f(wo, wi) |n . wi| E of a light with an extent with axis `a`
+/// (ExtendedLightAxisOf), illuminance E (I / d^2 or E_sun: SampleLight's), where `on`: the BRDF
+/// (BrdfEvalWorld: unit shading normal n, geometric normal ng, view direction wo, n_v = n . wo,
+/// c_diff, f0, a2 = alpha^2) at the direction to the light's centre, tilted above the horizon
+/// where the light straddles it (ExtendedLightShading, lane by lane), times E and the
+/// horizon-clipped factor (SphereLightCosine); +0 elsewhere. *wi, *dist: the shadow ray through
+/// the point's lattice point (SampleLight's), replaced by the shading direction and the near
+/// distance where that point lies below the geometric surface (it would test the surface
+/// itself, not the occluders).
+template <typename T, typename V, typename M>
+PB_HOST_DEVICE inline V ExtendedLightContribution(const ExtendedLightAxis<T, V, M>& a, const V& n,
+                                                  const V& ng, const V& wo, const T& n_v,
+                                                  const V& c_diff, const V& f0, const T& a2,
+                                                  const M& on, const V& E, V* wi, T* dist) {
+  V rep = a.w;
+  T scale = pbm::Where(on, pbm::StepGreaterThan(a.cos_t, 1e-6f));
+  pbm::ForEachLane(on && a.straddles, [&](int k) {
+    const float wk[3] = {pbm::LaneOf(a.w.x, k), pbm::LaneOf(a.w.y, k), pbm::LaneOf(a.w.z, k)};
+    const float nk[3] = {pbm::LaneOf(n.x, k), pbm::LaneOf(n.y, k), pbm::LaneOf(n.z, k)};
+    float r[3];
+    pbm::LaneOf(scale, k) = ExtendedLightShading(wk, pbm::LaneOf(a.sin2, k), nk, r);
+    pbm::LaneOf(rep.x, k) = r[0], pbm::LaneOf(rep.y, k) = r[1], pbm::LaneOf(rep.z, k) = r[2];
+  });
+  pbm::ForEachLane(!pbm::GreaterThan(pbm::Dot<T>(ng, *wi), 0.0f), [&](int k) {
+    pbm::LaneOf(wi->x, k) = pbm::LaneOf(rep.x, k), pbm::LaneOf(wi->y, k) = pbm::LaneOf(rep.y, k),
+                       pbm::LaneOf(wi->z, k) = pbm::LaneOf(rep.z, k);
+    pbm::LaneOf(*dist, k) = pbm::LaneOf(a.dist_near, k);
+  });
+  const V f = BrdfEvalWorld<T, V>(n, ng, wo, n_v, c_diff, f0, a2, rep);
+  return V{pbm::Where(on, T(f.x * E.x * scale)), pbm::Where(on, T(f.y * E.y * scale)),
+           pbm::Where(on, T(f.z * E.z * scale))};
+}
+
+/// the unshadowed contribution f(wo, wi) |n . wi| E of a light without an extent sampled in
+/// unit direction wi with illuminance E (SampleLight's), where `on`; +0 elsewhere (the BRDF's
+/// arguments as ExtendedLightContribution's).
+template <typename T, typename V, typename M>
+PB_HOST_DEVICE inline V PointLightContribution(const V& n, const V& ng, const V& wo, const T& n_v,
+                                               const V& c_diff, const V& f0, const T& a2,
+                                               const M& on, const V& E, const V& wi) {
+  const V f = BrdfEvalWorld<T, V>(n, ng, wo, n_v, c_diff, f0, a2, wi);
+  return V{pbm::Where(on, T(f.x * E.x)), pbm::Where(on, T(f.y * E.y)),
+           pbm::Where(on, T(f.z * E.z))};
+}
+
 /// the unshadowed contribution f(wo, wi) |n . wi| E of light j at p for pixel (u, v), as the
-/// CPU realtime integrator computes it (0 where the light sends nothing): a light without an
-/// extent sampled at the pixel's lattice point; a lamp or sun disc in closed form
-/// (ExtendedLightShading: the BRDF towards the light's centre, tilted above the horizon where
-/// the light straddles it). *wi, *dist: the shadow ray of the pixel's first lattice point (the
-/// shading direction where that point lies below the geometric surface).
+/// CPU realtime integrator computes it for its lanes (0 where the light sends nothing): a light
+/// without an extent sampled at the pixel's lattice point (PointLightContribution); a lamp or
+/// sun disc in closed form (ExtendedLightAxisOf, ExtendedLightContribution). *wi, *dist: the
+/// shadow ray of the pixel's first lattice point (the shading direction where that point lies
+/// below the geometric surface).
 PB_HOST_DEVICE inline Float3 LightContribution(const RealtimeFrameView& f, int j, int u, int v,
                                                const Float3& p, const Float3& n, const Float3& ng,
                                                const Float3& wo, float n_v, const Float3& c_diff,
@@ -76,31 +162,12 @@ PB_HOST_DEVICE inline Float3 LightContribution(const RealtimeFrameView& f, int j
   const LightPod& l = f.lights[j];
   SampleLight<float, Float3, bool>(l, p, u1, u2, wi, dist, &E, &valid);
   if (!valid) return Float3{0, 0, 0};
-  if (!IsExtendedLightPod(l)) {
-    const Float3 fr = BrdfEvalWorld<float, Float3>(n, ng, wo, n_v, c_diff, f0, a2, *wi);
-    return Float3{fr.x * E.x, fr.y * E.y, fr.z * E.z};
-  }
-  // the axis, sin^2 sigma and near distance.
-  float w[3], sin2, dist_near;
-  if (l.kind == LightKind::kDirectional) {
-    w[0] = -l.direction_W.x, w[1] = -l.direction_W.y, w[2] = -l.direction_W.z;
-    sin2 = 1.0f - l.cos_angular_radius * l.cos_angular_radius;
-    dist_near = INFINITY;
-  } else {
-    const float c[3] = {l.position_W.x, l.position_W.y, l.position_W.z};
-    const float pp[3] = {p.x, p.y, p.z};
-    SphereLightAxis(c, l.radius_m, pp, w, &sin2, &dist_near);
-  }
-  const float nn[3] = {n.x, n.y, n.z};
-  const float cos_t = nn[0] * w[0] + nn[1] * w[1] + nn[2] * w[2];
-  const float sin_sigma = sqrtf(pbm::Max(sin2, 0.0f));
-  float rep[3] = {w[0], w[1], w[2]};
-  float scale = cos_t > 1e-6f ? 1.0f : 0.0f;
-  if (LightStraddlesHorizon(cos_t, sin2, sin_sigma)) scale = ExtendedLightShading(w, sin2, nn, rep);
-  const Float3 wi_rep{rep[0], rep[1], rep[2]};
-  if (!(pbm::Dot<float>(ng, *wi) > 0)) *wi = wi_rep, *dist = dist_near;
-  const Float3 fr = BrdfEvalWorld<float, Float3>(n, ng, wo, n_v, c_diff, f0, a2, wi_rep);
-  return Float3{fr.x * E.x * scale, fr.y * E.y * scale, fr.z * E.z * scale};
+  if (!IsExtendedLightPod(l))
+    return PointLightContribution<float, Float3, bool>(n, ng, wo, n_v, c_diff, f0, a2, true, E,
+                                                       *wi);
+  const ExtendedLightAxis<float, Float3, bool> a =
+      ExtendedLightAxisOf<float, Float3, bool>(l, p, n);
+  return ExtendedLightContribution(a, n, ng, wo, n_v, c_diff, f0, a2, true, E, wi, dist);
 }
 
 /// the sky term of one pixel from its primary geometry g: SkyBackground (the MJCF skybox, else
