@@ -341,26 +341,26 @@ void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scra
       if (primary.did_hit[i]) scratch->sky_E[i] = ctx.sky->Irradiance(scratch->n_s[i]);
     return;
   }
-  const float max_extent = 0.25f * volume->spacing();
-  constexpr float kPlaneTolM = 1e-3f;
   SkyIrradianceVolume::ShBlend blend;
   auto shared = [&](int, int, const int* quad) {
     const int i00 = quad[0];
-    for (int c = 0; c < 4; ++c) {
-      const int i = quad[c];
-      if (!(primary.did_hit[i] && primary.hits[i].geom == primary.hits[i00].geom &&
-            primary.hits[i].ng_W == primary.hits[i00].ng_W))
-        return false;
-    }
+    // the transport's rule (render/transport/realtime_shading.h) over the tile's hits.
+    struct {
+      const PrimaryHits* primary;
+      const int* quad;
+      bool Hit(int c) const { return primary->did_hit[quad[c]]; }
+      int Geom(int c) const { return primary->hits[quad[c]].geom; }
+      void Ng(int c, float ng[3]) const {
+        for (int a = 0; a < 3; ++a) ng[a] = primary->hits[quad[c]].ng_W[a];
+      }
+      void P(int c, float p[3]) const {
+        for (int a = 0; a < 3; ++a) p[a] = primary->hits[quad[c]].p_W[a];
+      }
+    } q{&primary, quad};
+    float m[3];
+    if (!cuda::SkyQuadSharesBlend(q, volume->spacing(), m)) return false;
+    const Eigen::Vector3f mean(m[0], m[1], m[2]);
     const Eigen::Vector3f& n0 = primary.hits[i00].ng_W;
-    const Eigen::Vector3f& p0 = primary.hits[i00].p_W;
-    Eigen::Vector3f mean = Eigen::Vector3f::Zero();
-    for (int c = 0; c < 4; ++c) {
-      const Eigen::Vector3f dp = primary.hits[quad[c]].p_W - p0;
-      if (!(std::abs(n0.dot(dp)) <= kPlaneTolM && dp.cwiseAbs().maxCoeff() <= max_extent))
-        return false;
-      mean += 0.25f * primary.hits[quad[c]].p_W;
-    }
     volume->Blend(mean, n0, &blend);
     // IrradianceAt is a function of the blend and the normal: pixels whose shading normals are
     // bitwise equal to the first's (a flat face without a normal map: every quad of the default
@@ -560,16 +560,8 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     bsdf.SetCoefficients(pbr);
 
     // emission and sky ambient, E_sky / pi (c_diff (1 - S) + S).
-    {
-      const Vec3Lanes spec =
-          EnvBrdfApprox<Lanes, Vec3Lanes>(bsdf.f0, bsdf.n_v.max(0.0f), pbr.roughness);
-      const Vec3Lanes reflect{bsdf.c_diff.x * (1.0f - spec.x) + spec.x,
-                              bsdf.c_diff.y * (1.0f - spec.y) + spec.y,
-                              bsdf.c_diff.z * (1.0f - spec.z) + spec.z};
-      L = {emission.x + (sky_E.x * pbm::kInvPi) * reflect.x,
-           emission.y + (sky_E.y * pbm::kInvPi) * reflect.y,
-           emission.z + (sky_E.z * pbm::kInvPi) * reflect.z};
-    }
+    L = cuda::AmbientRadiance<Lanes, Vec3Lanes>(emission, sky_E, bsdf.c_diff, bsdf.f0, bsdf.n_v,
+                                                pbr.roughness);
 
     // where the surface points lie in the media's light volume (shared by all lights).
     float vol_T[kLanes][kMaxVolumeLights];
@@ -631,7 +623,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       if (!lit.any()) continue;
       const LaneMask shadowed =
           ctx.lights->lights()[j].cast_shadow && ablation.shadows
-              ? lit && GreaterEqual(LuminanceLanes(c), kNegligibleLight * total)
+              ? lit && cuda::ShadowRayWorthTracing<Lanes, LaneMask>(LuminanceLanes(c), total)
               : LaneMask::Constant(false);
       const LaneMask unshadowed = lit && !shadowed;
       L = L + Where(unshadowed, c);

@@ -29,10 +29,17 @@
 // lattice: one random point per pixel and frame gives salt-and-pepper speckle wherever a lamp is
 // partly hidden or near the horizon, and different speckle every frame.
 //
-// shadow rays are skipped for lights that contribute less than kNegligibleLight of the
-// pixel's unshadowed radiance (their contribution is added unshadowed). random numbers: only
-// for the mirror layer's light samples, Rng(ctx.PixelStream(u, v, 0)) from draw
-// number-of-lights on.
+// shadow rays are skipped for lights that contribute less than kGpuNegligibleLight (1e-3) of
+// the pixel's unshadowed radiance (ShadowRayWorthTracing, render/transport/realtime_shading.h;
+// their contribution is added unshadowed). random numbers: only for the mirror layer's light
+// samples, Rng(ctx.PixelStream(u, v, 0)) from draw number-of-lights on.
+//
+// written once with the CUDA backend (render/transport/realtime_*.h): the ambient term
+// (AmbientRadiance), the lights' unshadowed contributions (ExtendedLightAxisOf,
+// ExtendedLightContribution, PointLightContribution: templates over float and Lanes), the
+// negligible-light rule, the shared visibility's windows, fractions and resolve, and the
+// mirror layer (render/cpu/mirror_layer.h). this file is their driver: the tile loop, scratch
+// buffers, Embree packets, the CPU's materials, sky lookups and view effects.
 //
 // adverse conditions (FrameContext::effects): surface wetness changes the material of
 // upward-facing surfaces; each light's contribution is attenuated by the media between the
@@ -54,9 +61,6 @@
 #include "penumbra/render/cpu/integrator.h"
 
 namespace penumbra {
-
-/// lights below this fraction of a pixel's unshadowed radiance get no shadow ray.
-constexpr float kNegligibleLight = 1e-3f;
 
 /// direct lighting + sky ambient, 1 sample per pixel. stateless, thread-safe.
 class RealtimeIntegrator final : public Integrator {

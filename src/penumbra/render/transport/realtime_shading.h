@@ -195,6 +195,63 @@ PB_HOST_DEVICE inline Float3 PixelSkyTerm(const SkyModelPod& sky, const SkyVolum
   return Float3{e[0], e[1], e[2]};
 }
 
+/// whether the 4 pixels of a 2x2 quad (row-major) share one sky-volume blend: all hit a surface
+/// (q.Hit(c)) of one geom (q.Geom(c)) with bitwise equal geometric normals (q.Ng(c, ng)), their
+/// points (q.P(c, p), m) within 1 mm of the first's tangent plane and within a quarter probe
+/// `spacing` of the first point on every axis (the volume interpolates probes one spacing apart,
+/// so across such a quad it changes far less than 8-bit output resolves). *mean: the quad's mean
+/// point, 0.25 p summed in pixel order (valid where true).
+template <class Quad>
+PB_HOST_DEVICE inline bool SkyQuadSharesBlend(const Quad& q, float spacing, float mean[3]) {
+  float ng0[3], p0[3];
+  for (int c = 0; c < 4; ++c) {
+    if (!q.Hit(c)) return false;
+    if (c == 0) {
+      q.Ng(0, ng0);
+      q.P(0, p0);
+      continue;
+    }
+    float ng[3];
+    q.Ng(c, ng);
+    if (q.Geom(c) != q.Geom(0) || !(ng[0] == ng0[0] && ng[1] == ng0[1] && ng[2] == ng0[2]))
+      return false;
+  }
+  const float max_extent = 0.25f * spacing;
+  constexpr float kPlaneTolM = 1e-3f;
+  mean[0] = mean[1] = mean[2] = 0;
+  for (int c = 0; c < 4; ++c) {
+    float p[3];
+    q.P(c, p);
+    const float dp[3] = {p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]};
+    // x + (y + z): the order of Eigen's 3-vector dot, which the CPU used before.
+    const float n_dp = ng0[0] * dp[0] + (ng0[1] * dp[1] + ng0[2] * dp[2]);
+    if (!(fabsf(n_dp) <= kPlaneTolM && fabsf(dp[0]) <= max_extent && fabsf(dp[1]) <= max_extent &&
+          fabsf(dp[2]) <= max_extent))
+      return false;
+    mean[0] += 0.25f * p[0];
+    mean[1] += 0.25f * p[1];
+    mean[2] += 0.25f * p[2];
+  }
+  return true;
+}
+
+/// a quad of the frame's PixelGeometry records (SkyQuadSharesBlend's Quad): pixel c at
+/// geometry[quad[c]].
+struct GeometryQuad {
+  const PixelGeometry* geometry;
+  const int64_t* quad;
+  PB_HOST_DEVICE bool Hit(int c) const { return geometry[quad[c]].hit != 0; }
+  PB_HOST_DEVICE int Geom(int c) const { return geometry[quad[c]].geom; }
+  PB_HOST_DEVICE void Ng(int c, float ng[3]) const {
+    const Float3& n = geometry[quad[c]].ng;
+    ng[0] = n.x, ng[1] = n.y, ng[2] = n.z;
+  }
+  PB_HOST_DEVICE void P(int c, float p[3]) const {
+    const Float3& q = geometry[quad[c]].p_or_d;
+    p[0] = q.x, p[1] = q.y, p[2] = q.z;
+  }
+};
+
 /// the sky terms (RealtimeFrameView::sky_term) of the 2x2 quad at even (u0, v0) of a
 /// width-pixel image (pixels at or below row1 and right of the image left out), as
 /// RealtimeIntegrator's TileSkyIrradiance: with a sky volume, a quad whose pixels see one flat
@@ -207,42 +264,22 @@ PB_HOST_DEVICE inline void QuadSkyTerms(const SkyModelPod& sky, const SkyVolumeP
   const int64_t i00 = static_cast<int64_t>(v0) * width + u0;
   const int64_t quad[4] = {i00, i00 + 1, i00 + width, i00 + width + 1};
   const bool occluded = !volume.empty();
-  bool shared = occluded && u0 + 1 < width && v0 + 1 < row1;
-  if (shared) {
+  float mean[3];
+  if (occluded && u0 + 1 < width && v0 + 1 < row1 &&
+      SkyQuadSharesBlend(GeometryQuad{geometry, quad}, volume.spacing, mean)) {
     const PixelGeometry& g0 = geometry[quad[0]];
-    for (int c = 0; c < 4 && shared; ++c) {
-      const PixelGeometry& g = geometry[quad[c]];
-      shared = g.hit != 0 && g.geom == g0.geom && g.ng.x == g0.ng.x && g.ng.y == g0.ng.y &&
-               g.ng.z == g0.ng.z;
+    const float n0[3] = {g0.ng.x, g0.ng.y, g0.ng.z};
+    float c[kSkyShStride];
+    bool open_sky;
+    SkyVolumeBlend(volume, mean, n0, c, &open_sky);
+    for (int k = 0; k < 4; ++k) {
+      const PixelGeometry& g = geometry[quad[k]];
+      const float ns[3] = {g.ns.x, g.ns.y, g.ns.z};
+      float e[3];
+      SkyVolumeIrradianceAt(sky, c, open_sky, ns, e);
+      out[quad[k]] = Float3{e[0], e[1], e[2]};
     }
-    const float max_extent = 0.25f * volume.spacing;
-    constexpr float kPlaneTolM = 1e-3f;
-    float mean[3] = {0, 0, 0};
-    for (int c = 0; c < 4 && shared; ++c) {
-      const PixelGeometry& g = geometry[quad[c]];
-      const float dp[3] = {g.p_or_d.x - g0.p_or_d.x, g.p_or_d.y - g0.p_or_d.y,
-                           g.p_or_d.z - g0.p_or_d.z};
-      const float n_dp = g0.ng.x * dp[0] + (g0.ng.y * dp[1] + g0.ng.z * dp[2]);
-      shared = fabsf(n_dp) <= kPlaneTolM && fabsf(dp[0]) <= max_extent &&
-               fabsf(dp[1]) <= max_extent && fabsf(dp[2]) <= max_extent;
-      mean[0] += 0.25f * g.p_or_d.x;
-      mean[1] += 0.25f * g.p_or_d.y;
-      mean[2] += 0.25f * g.p_or_d.z;
-    }
-    if (shared) {
-      const float n0[3] = {g0.ng.x, g0.ng.y, g0.ng.z};
-      float c[kSkyShStride];
-      bool open_sky;
-      SkyVolumeBlend(volume, mean, n0, c, &open_sky);
-      for (int k = 0; k < 4; ++k) {
-        const PixelGeometry& g = geometry[quad[k]];
-        const float ns[3] = {g.ns.x, g.ns.y, g.ns.z};
-        float e[3];
-        SkyVolumeIrradianceAt(sky, c, open_sky, ns, e);
-        out[quad[k]] = Float3{e[0], e[1], e[2]};
-      }
-      return;
-    }
+    return;
   }
   for (int c = 0; c < 4; ++c)
     if (u0 + (c & 1) < width && v0 + (c >> 1) < row1)
@@ -381,6 +418,29 @@ struct ShadeSetup {
   F3 origin;
 };
 
+/// the radiance of a shading point before its lights, for a float or Lanes: its emission plus
+/// the ambient term E_sky / pi (c_diff (1 - S) + S), sky_E the occluded sky irradiance on the
+/// shading normal times the material's occlusion, S the split-sum fit (EnvBrdfApprox at
+/// max(n_v, 0) and the roughness) of the BRDF's c_diff and f0 (BrdfCoefficientsOf).
+template <typename T, typename V>
+PB_HOST_DEVICE inline V AmbientRadiance(const V& emission, const V& sky_E, const V& c_diff,
+                                        const V& f0, const T& n_v, const T& roughness) {
+  const V spec = EnvBrdfApprox<T, V>(f0, pbm::Max(n_v, 0.0f), roughness);
+  const V reflect{c_diff.x * (1.0f - spec.x) + spec.x, c_diff.y * (1.0f - spec.y) + spec.y,
+                  c_diff.z * (1.0f - spec.z) + spec.z};
+  return V{emission.x + (sky_E.x * pbm::kInvPi) * reflect.x,
+           emission.y + (sky_E.y * pbm::kInvPi) * reflect.y,
+           emission.z + (sky_E.z * pbm::kInvPi) * reflect.z};
+}
+
+/// whether a lit light of luminance lum (> 0) at a point whose unshadowed total is `total` is
+/// worth a shadow ray: it is not negligible (kGpuNegligibleLight of the total); a float or
+/// every lane.
+template <typename T, typename M>
+PB_HOST_DEVICE inline M ShadowRayWorthTracing(const T& lum, const T& total) {
+  return pbm::GreaterEqual(lum, T(kGpuNegligibleLight * total));
+}
+
 /// ShadeSetup of shading point sp with sky term `sky` (E_sky where the pixel's ray hits).
 PB_HOST_DEVICE inline ShadeSetup BeginShadePoint(const ShadingPoint& sp, const Float3& sky) {
   ShadeSetup s;
@@ -394,13 +454,7 @@ PB_HOST_DEVICE inline ShadeSetup BeginShadePoint(const ShadingPoint& sp, const F
                                     &alpha);
   s.a2 = alpha * alpha;
   s.n_v = pbm::Dot<float>(sp.n, sp.wo);
-  const Float3 spec = EnvBrdfApprox<float, Float3>(s.f0, pbm::Max(s.n_v, 0.0f), roughness);
-  const Float3 reflect{s.c_diff.x * (1.0f - spec.x) + spec.x, s.c_diff.y * (1.0f - spec.y) + spec.y,
-                       s.c_diff.z * (1.0f - spec.z) + spec.z};
-  const Float3 sky_E = occlusion * sky;
-  s.L = Float3{emission.x + (sky_E.x * pbm::kInvPi) * reflect.x,
-               emission.y + (sky_E.y * pbm::kInvPi) * reflect.y,
-               emission.z + (sky_E.z * pbm::kInvPi) * reflect.z};
+  s.L = AmbientRadiance<float, Float3>(emission, occlusion * sky, s.c_diff, s.f0, s.n_v, roughness);
   // shadow rays start off the surface on the lit side.
   s.origin = OffsetOrigin(sp.p, sp.ng);
   return s;
@@ -453,9 +507,9 @@ PB_HOST_DEVICE inline Float3 KeptLight(const RealtimeFrameView& f, int j, int u,
 }
 
 /// a light of luminance lum (> 0) at a pixel whose unshadowed total is `total` gets a shadow
-/// ray: it casts shadows and is not negligible (kGpuNegligibleLight of the total).
+/// ray: it casts shadows and is not negligible (ShadowRayWorthTracing).
 PB_HOST_DEVICE inline bool WantsShadowRay(const LightPod& l, float lum, float total) {
-  return l.cast_shadow != 0 && lum >= kGpuNegligibleLight * total;
+  return l.cast_shadow != 0 && ShadowRayWorthTracing<float, bool>(lum, total);
 }
 
 /// the shadow ray from `origin` towards a light in unit direction wi at distance dist (stops
