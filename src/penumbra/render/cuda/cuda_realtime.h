@@ -215,7 +215,7 @@ class DeviceRealtime : NonCopyable {
   using ExposureFn = std::function<double(const std::vector<double>& rows, float exposure[3])>;
 
   /// the late streaks (Render's `streaks`): sets the particle streak fields of
-  /// *frame (streaks and num_streaks, splat: host arrays that stay valid until Render returns;
+  /// *frame (splat: host arrays that stay valid until Render returns;
   /// RealtimeFrameData::StreakFields) and leaves the rest alone. called on Render's thread once
   /// every kernel before the streaks' is queued, so the host makes the streaks while the GPU
   /// traces and shades the frame.

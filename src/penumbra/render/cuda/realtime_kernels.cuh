@@ -195,14 +195,12 @@ struct MediaStreakBuffers {
   size_t grid_built_values = 0;
   int64_t grid_built_cells = 0;
   int grid_built_columns = 0;
-  // the host splat's pixels; the realtime splat's streaks (shared with the pathtraced tier's
-  // upload) and per pixel its StreakKeys and shaded streaks (StreakSplatView)
-  Buffer streaks;
+  // the realtime splat's streaks (shared with the pathtraced tier's upload) and per pixel its
+  // StreakKeys and shaded streaks (StreakSplatView)
   StreakBuffers splat_streaks;
   Buffer splat_nearest, splat_pixels, splat_rows;
-  // page-locked staging of the late streaks: the host splat's pixels, the device splat's
-  // streaks and row poses
-  PinnedBuffer pin_streak_pixels, pin_splat, pin_splat_rows;
+  // page-locked staging of the late streaks: the splat's streaks and row poses
+  PinnedBuffer pin_splat, pin_splat_rows;
 
   // the frame's media (host arrays of `h`, RealtimeFrameData::View) to the device on `stream`
   // (pageable: staged before the calls return), *d pointing to them; `volume`: the device's
@@ -214,9 +212,9 @@ struct MediaStreakBuffers {
   // f->media pointed at their buffers. `h`: the host's media view.
   void BuildMedia(const RealtimeMediaView& h, RealtimeFrameView* f, cudaStream_t stream);
   // the particle streaks of host frame h to the device on `stream`, f's streak fields pointing
-  // at them (n: the frame's pixels): the host splat's pixels, or the device splat's streaks
-  // (host arrays; or the device culling's, read in place: their sets only, the count on the
-  // device, StreakSplatView::count), then their splat queued (LaunchStreakSplat). staged:
+  // at them (n: the frame's pixels): the splat's streaks (host arrays; or the device
+  // culling's, read in place: their sets only, the count on the device,
+  // StreakSplatView::count), then their splat queued (LaunchStreakSplat). staged:
   // through page-locked staging (the last frame's copies from it are done: it ended with a
   // synchronisation), so that the host never waits for a busy stream (the late streaks).
   void QueueStreaks(const RealtimeFrameView& h, RealtimeFrameView* f, int64_t n, bool staged,
@@ -232,12 +230,12 @@ struct MediaStreakBuffers {
 // every pixel's key cleared, the streaks splatted, the pixels with one shaded.
 void LaunchStreakSplat(const RealtimeFrameView& f, cudaStream_t stream);
 // what changes frame f's radiance after the shared visibility's resolve: the media's view pass
-// (with the streaks seen through them), else the host splat's or the device splat's streaks.
+// (with the streaks seen through them), else the splat's streaks.
 void LaunchViewPasses(const RealtimeFrameView& f, const float* depth, Float3* radiance,
                       cudaStream_t stream);
 // whether frame f has such passes (so no output band is final before them).
 inline bool HasViewPasses(const RealtimeFrameView& f) {
-  return f.has_media != 0 || f.num_streaks > 0 || f.splat.streaks.num > 0;
+  return f.has_media != 0 || f.splat.streaks.num > 0;
 }
 
 // ---- row sums, exposure and film (realtime_film.cu) ----

@@ -10,16 +10,6 @@
 namespace penumbra::cuda::realtime {
 namespace {
 
-// the particle streaks over the final radiance (ApplyStreak): one thread per streak pixel, each
-// pixel at most once.
-__global__ void StreakKernel(const StreakPixel* streaks, int64_t count, const float* depth,
-                             Float3* radiance) {
-  const int64_t k = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
-  if (k >= count) return;
-  const StreakPixel s = streaks[k];
-  radiance[s.pixel] = ApplyStreak(s, depth[s.pixel], radiance[s.pixel]);
-}
-
 // the splat's warps at most when the streaks' count is on the device (StreakSplatView::count):
 // about as many as an H100 holds resident (132 SMs x 64), more than a rain frame's streaks.
 constexpr int64_t kSplatWarps = 8192;
@@ -333,8 +323,6 @@ void LaunchStreakSplat(const RealtimeFrameView& f, cudaStream_t stream) {
 
 void MediaStreakBuffers::QueueStreaks(const RealtimeFrameView& h, RealtimeFrameView* f, int64_t n,
                                       bool staged, cudaStream_t stream) {
-  f->streaks = h.streaks;
-  f->num_streaks = h.num_streaks;
   f->splat = h.splat;
   // src, or (staged) its copy in *pin
   const auto source = [staged](const void* src, size_t bytes, PinnedBuffer* pin) {
@@ -343,11 +331,6 @@ void MediaStreakBuffers::QueueStreaks(const RealtimeFrameView& h, RealtimeFrameV
     std::memcpy(pin->p, src, bytes);
     return static_cast<const void*>(pin->p);
   };
-  if (h.num_streaks > 0) {
-    const size_t bytes = sizeof(StreakPixel) * h.num_streaks;
-    streaks.Upload(source(h.streaks, bytes, &pin_streak_pixels), bytes, stream);
-    f->streaks = streaks.as<StreakPixel>();
-  }
   if (h.splat.streaks.num > 0 && h.splat.count != nullptr) {
     // the device culling's streaks, read in place (their culler made `stream` wait for
     // them): only their sets go over
@@ -381,10 +364,6 @@ void LaunchViewPasses(const RealtimeFrameView& f, const float* depth, Float3* ra
     LaunchKernel("MediaViewKernel", MediaViewKernel, PixelGrid((W + 1) / 2, (H + 1) / 2),
                  PixelBlock(), 0, stream, f, depth, radiance);
     return;
-  }
-  if (f.num_streaks > 0) {
-    LaunchKernel("StreakKernel", StreakKernel, static_cast<unsigned>((f.num_streaks + 255) / 256),
-                 256, 0, stream, f.streaks, f.num_streaks, depth, radiance);
   }
   if (f.splat.streaks.num > 0) {
     LaunchKernel("StreakSplatApplyKernel", StreakSplatApplyKernel, PixelGrid(W, H), PixelBlock(), 0,

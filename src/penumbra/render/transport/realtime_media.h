@@ -259,7 +259,7 @@ PB_HOST_DEVICE inline Float3 MediaFogSlice(const RealtimeFrameView& f, int c, in
 /// tiles, which start at even pixels, so its quads are these. a pixel with a particle streak in
 /// front of its hit (PixelStreakOf) then gets it over L (ApplyStreak) with the streak's radiance
 /// seen through the media up to it (MediaViewSegment to s.t |d|, the same quad lookups), as
-/// the CPU's ApplyViewEffects; StreakKernel does not run for frames with media.
+/// the CPU's ApplyViewEffects; StreakSplatApplyKernel does not run for frames with media.
 PB_HOST_DEVICE inline void MediaViewQuad(const RealtimeFrameView& f, int u0, int v0,
                                          const float* depth, Float3* radiance) {
   const int W = f.camera.width, H = f.camera.height;

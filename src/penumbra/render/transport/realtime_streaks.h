@@ -1,8 +1,8 @@
 #pragma once
 // the realtime tier's particle streaks (rain, snow, sparks): splatted per pixel by the frame
 // (SplatStreakRow, ShadeSplatPixel over render/particles/particle_math.h's projection and capsule
-// test, as the CPU's ParticleStreaks::BuildPixelHits) or found in the host splat's list
-// (PixelStreakOf), drawn over the pixel's radiance by ApplyStreak (scene_view.h).
+// test, as the CPU's ParticleStreaks::BuildPixelHits), a pixel's found by PixelStreakOf and drawn
+// over its radiance by ApplyStreak (scene_view.h).
 
 #include <cstdint>
 
@@ -12,20 +12,6 @@
 #include "penumbra/render/transport/scene_view.h"
 
 namespace penumbra::cuda {
-
-/// the index in f.streaks (sorted by pixel) of pixel i's streak, -1 if it has none (binary
-/// search).
-PB_HOST_DEVICE inline int64_t FindStreak(const RealtimeFrameView& f, int64_t i) {
-  int64_t lo = 0, hi = f.num_streaks;
-  while (lo < hi) {
-    const int64_t mid = lo + (hi - lo) / 2;
-    if (f.streaks[mid].pixel < i)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
-  return lo < f.num_streaks && f.streaks[lo].pixel == i ? lo : -1;
-}
 
 /// the projection of splat streak s (ProjectStreak of its ends in the frame's optical frame,
 /// StreakToOptical), its box widened by a moving camera's rows (WidenStreakForMotion; nothing
@@ -148,17 +134,11 @@ PB_HOST_DEVICE inline void ShadeSplatPixel(const RealtimeFrameView& f, int u, in
                       f.splat.streaks.sky_ambient);
 }
 
-/// pixel i's streak, shaded (*s), if it has one: the device splat's (f.splat) or the host
-/// splat's (FindStreak in f.streaks).
+/// pixel i's streak after the splat (f.splat: SplatStreakRow, ShadeSplatPixel), shaded (*s), if
+/// it has one; false for a frame without streaks.
 PB_HOST_DEVICE inline bool PixelStreakOf(const RealtimeFrameView& f, int64_t i, StreakPixel* s) {
-  if (f.splat.streaks.num > 0) {
-    if (f.splat.nearest[i] == kNoStreakKey) return false;
-    *s = f.splat.pixels[i];
-    return true;
-  }
-  const int64_t k = FindStreak(f, i);
-  if (k < 0) return false;
-  *s = f.streaks[k];
+  if (f.splat.streaks.num <= 0 || f.splat.nearest[i] == kNoStreakKey) return false;
+  *s = f.splat.pixels[i];
   return true;
 }
 
