@@ -13,6 +13,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "penumbra/render/cuda/cuda_device_buffer.h"
@@ -268,6 +270,12 @@ void LaunchBatchDevelop(const Float3* radiance, int64_t n, int count, const Real
 
 // ---- the per-pixel buffers of a frame or a batch ----
 
+// the element type of the RealtimeFrameView array (T* or const T*) that member pointer type M
+// names.
+template <class M>
+using ViewElement = std::remove_const_t<std::remove_pointer_t<
+    std::remove_reference_t<decltype(std::declval<RealtimeFrameView&>().*std::declval<M>())>>>;
+
 // the chunks of the penumbra rays' queue of a frame (DeviceRealtime) and of a batch (many
 // cameras fill the device: fewer, longer chunks).
 constexpr int kFramePenumbraChunkRays = 1;
@@ -291,27 +299,14 @@ struct PixelBuffers {
   // room for n pixels (all cameras) and nl = n x lights (lights >= 1); the mirror layer's if
   // `mirror`
   void Reserve(int64_t n, int64_t nl, bool mirror) {
-    geometry.Reserve(sizeof(PixelGeometry) * n);
-    sky.Reserve(sizeof(Float3) * n);
     radiance.Reserve(sizeof(Float3) * n);
     surfaces.Reserve(sizeof(SurfaceTerms) * n);
-    window.Reserve(sizeof(uint32_t) * n);
-    total.Reserve(sizeof(float) * n);
-    area_c.Reserve(sizeof(Float3) * nl);
-    area_vis.Reserve(sizeof(int8_t) * nl);
-    area_visible.Reserve(sizeof(float) * nl);
-    area_rays.Reserve(sizeof(float) * nl);
-    area_own.Reserve(sizeof(uint8_t) * nl);
-    area_fraction.Reserve(sizeof(float) * nl);
+    ForEachViewArray(*this, mirror, [n, nl](Buffer& b, auto field, bool per_light) {
+      b.Reserve(sizeof(ViewElement<decltype(field)>) * (per_light ? nl : n));
+    });
     penumbra_queue.Reserve(static_cast<size_t>(PenumbraQueueBytes(nl)));
     penumbra_queued.Reserve(sizeof(unsigned long long));
     penumbra_counts.Reserve(sizeof(uint32_t) * nl);
-    if (mirror) {
-      mirror_geometry.Reserve(sizeof(PixelGeometry) * n);
-      mirror_hits.Reserve(sizeof(TraceHit) * n);
-      mirror_sky.Reserve(sizeof(Float3) * n);
-      mirror_radiance.Reserve(sizeof(Float3) * n);
-    }
   }
   // the shadow-ray queue for `n` pixels in all and `lights` lights (QueueShadowRays holds)
   ShadowRayQueue ShadowQueue(int64_t n, int lights) {
@@ -335,22 +330,33 @@ struct PixelBuffers {
   }
   // f's per-pixel arrays: the part at pixel `at` and, per light, at `at_l`
   void Point(RealtimeFrameView* f, int64_t at, int64_t at_l, bool mirror) const {
-    f->sky_term = sky.as<Float3>() + at;
-    f->geometry = geometry.as<PixelGeometry>() + at;
-    f->window = window.as<uint32_t>() + at;
-    f->total = total.as<float>() + at;
-    f->area_c = area_c.as<Float3>() + at_l;
-    f->area_vis = area_vis.as<int8_t>() + at_l;
-    f->area_visible = area_visible.as<float>() + at_l;
-    f->area_rays = area_rays.as<float>() + at_l;
-    f->area_own = area_own.as<uint8_t>() + at_l;
-    f->area_fraction = area_fraction.as<float>() + at_l;
-    if (mirror) {
-      f->mirror_geometry = mirror_geometry.as<PixelGeometry>() + at;
-      f->mirror_hits = mirror_hits.as<TraceHit>() + at;
-      f->mirror_sky = mirror_sky.as<Float3>() + at;
-      f->mirror_radiance = mirror_radiance.as<Float3>() + at;
-    }
+    ForEachViewArray(*this, mirror, [f, at, at_l](const Buffer& b, auto field, bool per_light) {
+      f->*field = b.as<ViewElement<decltype(field)>>() + (per_light ? at_l : at);
+    });
+  }
+
+ private:
+  // fn(buffer, its field of RealtimeFrameView, whether it holds a value per pixel and light or
+  // per pixel) for every buffer a frame's view points into (Point), each field's type the
+  // buffer's element (Reserve); the mirror layer's with `mirror`.
+  template <class Self, class Fn>
+  static void ForEachViewArray(Self& self, bool mirror, Fn&& fn) {
+    using V = RealtimeFrameView;
+    fn(self.sky, &V::sky_term, false);
+    fn(self.geometry, &V::geometry, false);
+    fn(self.window, &V::window, false);
+    fn(self.total, &V::total, false);
+    fn(self.area_c, &V::area_c, true);
+    fn(self.area_vis, &V::area_vis, true);
+    fn(self.area_visible, &V::area_visible, true);
+    fn(self.area_rays, &V::area_rays, true);
+    fn(self.area_own, &V::area_own, true);
+    fn(self.area_fraction, &V::area_fraction, true);
+    if (!mirror) return;
+    fn(self.mirror_geometry, &V::mirror_geometry, false);
+    fn(self.mirror_hits, &V::mirror_hits, false);
+    fn(self.mirror_sky, &V::mirror_sky, false);
+    fn(self.mirror_radiance, &V::mirror_radiance, false);
   }
 };
 
