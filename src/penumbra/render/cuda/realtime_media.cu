@@ -60,15 +60,18 @@ __global__ void MediaViewKernel(RealtimeFrameView f, const float* depth, Float3*
   MediaViewQuad(f, 2 * qu, 2 * qv, depth, radiance);
 }
 
-// the media volumes a frame builds itself (RealtimeFrameView::media_build), before the kernels
-// that read them: one thread per cell of the world light volume (its shadow rays traced in the
-// thread), then the fog froxels (which read the light volume's visibility).
-__global__ void MediaLightVolumeKernel(RealtimeFrameView f, int64_t cells, float* trans_cl,
-                                       float* vis_cl) {
+// the light volumes a frame builds itself (RealtimeFrameView::media_build), before the kernels
+// that read them: one thread per cell c < cells, its shadow rays traced in the thread,
+// Cell(f, c, out...): the world light volume's (MediaLightVolumeCell, before the fog froxels,
+// which read its visibility) and the grids' (MediaGridLightCell, every grid's cells counted end
+// to end, before the grid froxels, which read their sources).
+template <auto Cell, class... Out>
+__global__ void LightVolumeCellKernel(RealtimeFrameView f, int64_t cells, Out... out) {
   const int64_t c = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (c >= cells) return;
-  MediaLightVolumeCell(f, c, trans_cl, vis_cl);
+  Cell(f, c, out...);
 }
+
 // one block per fog froxel column, one thread per slice (kFogFroxelSlices of kFogSliceBlock),
 // then the column's records summed in slice order by its first thread (FogFroxelRecords: the
 // bits of MediaFogColumn's serial loop).
@@ -94,15 +97,6 @@ __global__ void MediaFogSliceKernel(RealtimeFrameView f, const float* vis_cl, Rg
                    reinterpret_cast<float*>(S + static_cast<int64_t>(c) * (kFogFroxelSlices + 1)));
 }
 
-// the grids' light volumes a frame builds itself (f.media_build.grids), before the kernels
-// that read them: one thread per cell of every grid's volume, counted end to end (its shadow
-// rays traced in the thread; MediaGridLightCell).
-__global__ void MediaGridLightKernel(RealtimeFrameView f, int64_t cells, float* grid_T,
-                                     Float3* source) {
-  const int64_t c = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
-  if (c >= cells) return;
-  MediaGridLightCell(f, c, grid_T, source);
-}
 // the grid froxels (after the grids' light volumes, whose sources they read): one block per
 // column, one thread per slice (kFroxelSlices of kGridSliceBlock; MediaGridSlice), then the
 // column's records accumulated in slice order by its first thread (GridFroxelRecords: the bits of
@@ -228,7 +222,7 @@ void MediaStreakBuffers::UploadMedia(const RealtimeMediaView& h, const SkyVolume
 }
 // the grids' volumes frame f builds itself (f->media_build.grids), on `stream` after
 // UploadMedia and before the world light volume and fog froxels (which read them): the grids'
-// arrays uploaded when their generation changed, MediaGridLightKernel, then
+// arrays uploaded when their generation changed, the grids' light volumes, then
 // MediaGridFroxelKernel; f->media pointed at their buffers
 void MediaStreakBuffers::BuildGridMedia(const RealtimeMediaView& h, RealtimeFrameView* f,
                                         cudaStream_t stream) {
@@ -248,7 +242,7 @@ void MediaStreakBuffers::BuildGridMedia(const RealtimeMediaView& h, RealtimeFram
   media_grid_T.Reserve(sizeof(float) * GridLightValues(h));
   media_grid_source.Reserve(sizeof(Float3) * static_cast<size_t>(cells > 0 ? cells : 1));
   if (cells > 0) {
-    LaunchKernel("MediaGridLightKernel", MediaGridLightKernel,
+    LaunchKernel("MediaGridLightKernel", LightVolumeCellKernel<MediaGridLightCell, float*, Float3*>,
                  static_cast<unsigned>((cells + 63) / 64), 64, 0, stream, *f, cells,
                  media_grid_T.as<float>(), media_grid_source.as<Float3>());
   }
@@ -272,7 +266,7 @@ void MediaStreakBuffers::BuildGridMedia(const RealtimeMediaView& h, RealtimeFram
   m.grid_records = media_grid_records.as<GridFroxelRecord<Rgb4>>();
 }
 // the media volumes frame f builds itself (f->media_build), on `stream` after UploadMedia: the
-// grids' (BuildGridMedia), then MediaLightVolumeKernel, then MediaFogSliceKernel; f->media
+// grids' (BuildGridMedia), then the world light volume, then MediaFogSliceKernel; f->media
 // pointed at their buffers
 void MediaStreakBuffers::BuildMedia(const RealtimeMediaView& h, RealtimeFrameView* f,
                                     cudaStream_t stream) {
@@ -288,7 +282,8 @@ void MediaStreakBuffers::BuildMedia(const RealtimeMediaView& h, RealtimeFrameVie
       media_vis.Reserve(bytes > 0 ? bytes : 4);
       vis = media_vis.as<float>();
     }
-    LaunchKernel("MediaLightVolumeKernel", MediaLightVolumeKernel,
+    LaunchKernel("MediaLightVolumeKernel",
+                 LightVolumeCellKernel<MediaLightVolumeCell, float*, float*>,
                  static_cast<unsigned>((cells + 127) / 128), 128, 0, stream, *f, cells,
                  media_trans.as<float>(), vis);
     m.light_trans = media_trans.as<float>();
