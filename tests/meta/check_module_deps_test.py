@@ -244,7 +244,7 @@ class CheckModuleDepsTest(unittest.TestCase):
             self.assertRegex(f.read(), r"(?m)^render: scene core$")
         rc, out = run_checker(tmp.name)
         self.assertEqual(rc, 0, out)
-        for header, planted, sub in (("camera.h", "embree/ray_scene.h", "render/embree"),
+        for header, planted, sub in (("camera/camera.h", "embree/ray_scene.h", "render/embree"),
                                      ("ray_query.h", "cpu/integrator.h", "render/cpu")):
             path = os.path.join(src, "render", header)
             with open(path, encoding="utf-8") as f:
