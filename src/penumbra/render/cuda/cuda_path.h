@@ -21,12 +21,10 @@
 namespace penumbra::cuda {
 
 /// the device side of the pathtraced tier.
-class DevicePath {
+class DevicePath : NonCopyable {
  public:
   DevicePath();
   ~DevicePath();
-  DevicePath(const DevicePath&) = delete;
-  DevicePath& operator=(const DevicePath&) = delete;
 
   /// copies the sky's sampling tables (host pointers) to the device; call again whenever the
   /// frame's sky changes (RealtimeFrameData::sky_generation). returns the device copy's pod.

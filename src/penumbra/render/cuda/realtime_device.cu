@@ -337,8 +337,8 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   f.scene = scene->device_view();
   m.WithDeviceArrays(&f);
   m.Point(&f, 0, 0, mirror);
-  // the particle streaks: the frame's now (the host splat's pixels, or the streaks the host
-  // culled and their splat, first), or late (`streaks`: none until the shading is queued)
+  // the particle streaks: the frame's now (the streaks, culled on the host or the device, and
+  // their splat, first), or late (`streaks`: none until the shading is queued)
   m.extras.QueueStreaks(streaks ? RealtimeFrameView() : host_frame, &f, n, /*staged=*/false,
                         stream);
   if (f.has_media != 0) {

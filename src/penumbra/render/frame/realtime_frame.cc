@@ -415,8 +415,6 @@ const PathStreakBuild& RealtimeFrameData::splat_streaks() const {
 }
 
 void RealtimeFrameData::StreakFields(RealtimeFrameView* f) const {
-  f->streaks = nullptr;
-  f->num_streaks = 0;
   f->splat = StreakSplatView();
   if (device_list_.bound > 0) {
     // the device culling's streaks in place: a bound here, their count on the device

@@ -12,21 +12,21 @@
 // visibility V_i shared between neighbouring pixels as the CPU shares it
 // (render/light/shadow_window_math.h: the ratio estimator of Heitz et al. 2018 over each pixel's
 // 5x5 same-surface window, cut at the 16x16 tiles' edges; SharedVisibilityRays / Fraction / Resolve
-// after ShadeRealtimePixel), the same negligible-light rule (no shadow ray below kNegligibleLight
-// of the unshadowed total) and shadow rays from OffsetRayOrigin. E_sky (occluded sky irradiance on
-// the surface normal, one probe blend per flat 2x2 quad as the CPU) and the sky radiance of rays
-// that escape come per pixel from QuadSkyTerms, the shared lookups of render/sky/sky_eval_math.h
-// that SkyModel and SkyIrradianceVolume call on the CPU (a kernel of their own, or the host's
-// RealtimeFrameData::SkyTerms). the mirror layer (SurfaceMaterial::mirror, weight r: L becomes
-// (1 - r) L + r L_m) as render/cpu/mirror_layer.cc: the mirrored view ray traced on the layer's
-// grid (render/light/mirror_math.h; TraceMirrorRay), its hit shaded with one random sample of every
-// light and a shadow ray and the occluded sky irradiance at the hit (MirrorSkyTerm, beside the
-// primary sky terms; ShadeMirrorHit), the other
-// layer pixels interpolated from the grid and blended (ApplyMirrorLayer). the lighting effects
-// reach it as the CPU's: the lights (scaled, extra) and the sky (moved sun, scaled) through
-// the frame's data, the surface wetness in EvaluateSurface (render/material/wetness_math.h). meshes
-// and height fields shade with their vertex normals mixed at the hit and map their textures by
-// their texcoords (HitShadingNormal, HitTexcoords: primary_pixel.h), escaping rays see the MJCF
+// after ShadeRealtimePixel), the same negligible-light rule (no shadow ray below
+// kGpuNegligibleLight of the unshadowed total) and shadow rays from OffsetRayOrigin. E_sky
+// (occluded sky irradiance on the surface normal, one probe blend per flat 2x2 quad as the CPU) and
+// the sky radiance of rays that escape come per pixel from QuadSkyTerms, the shared lookups of
+// render/sky/sky_eval_math.h that SkyModel and SkyIrradianceVolume call on the CPU (a kernel of
+// their own, or the host's RealtimeFrameData::SkyTerms). the mirror layer (SurfaceMaterial::mirror,
+// weight r: L becomes (1 - r) L + r L_m) as render/cpu/mirror_layer.cc: the mirrored view ray
+// traced on the layer's grid (render/light/mirror_math.h; TraceMirrorRay), its hit shaded with one
+// random sample of every light and a shadow ray and the occluded sky irradiance at the hit
+// (MirrorSkyTerm, beside the primary sky terms; ShadeMirrorHit), the other layer pixels
+// interpolated from the grid and blended (ApplyMirrorLayer). the lighting effects reach it as the
+// CPU's: the lights (scaled, extra) and the sky (moved sun, scaled) through the frame's data, the
+// surface wetness in EvaluateSurface (render/material/wetness_math.h). meshes and height fields
+// shade with their vertex normals mixed at the hit and map their textures by their texcoords
+// (HitShadingNormal, HitTexcoords: primary_pixel.h), escaping rays see the MJCF
 
 #include <cstdint>
 

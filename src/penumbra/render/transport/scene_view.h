@@ -21,8 +21,8 @@
 
 namespace penumbra::cuda {
 
-/// lights below this fraction of a pixel's unshadowed radiance get no shadow ray (as
-/// RealtimeIntegrator's kNegligibleLight).
+/// lights below this fraction of a pixel's unshadowed radiance get no shadow ray, on the CPU and
+/// the GPU (ShadowRayWorthTracing).
 constexpr float kGpuNegligibleLight = 1e-3f;
 /// render/ray.h's kRayOffsetScale (shadow-ray origins pushed off the surface).
 constexpr float kGpuRayOffsetScale = 5e-5f;
@@ -183,10 +183,6 @@ struct RealtimeFrameView {
   TraceHit* mirror_hits = nullptr;
   const Float3* mirror_sky = nullptr;
   Float3* mirror_radiance = nullptr;
-  /// streak pixels shaded before the frame, num_streaks of them in pixel order, drawn by the
-  /// view pass (RealtimeFrameData gives none: the frame splats its streaks itself, `splat`).
-  const StreakPixel* streaks = nullptr;
-  int64_t num_streaks = 0;
   /// the frame's particle streaks for the splat the frame makes itself (streaks.num 0: none).
   StreakSplatView splat;
   /// the frame's homogeneous media (fog, haze, dust; has_media 1), their arrays as device or
