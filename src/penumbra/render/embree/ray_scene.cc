@@ -246,6 +246,19 @@ struct RayScene::Impl {
     return false;
   }
 
+  // the closest hit of one ray over the whole scene (rtcIntersect1) in *rh; false for a miss or
+  // a ray Traceable refuses.
+  bool Closest(const Ray& ray, RTCRayHit* rh) const {
+    if (!Traceable(ray)) return false;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ToEmbree(ray, &rh->ray);
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(top, &ctx, rh);
+    return rh->hit.geomID != RTC_INVALID_GEOMETRY_ID;
+  }
+
   void Check(const char* what) const {
     if (!error.empty()) throw Error(std::string("RayScene: ") + what + ": " + error);
     const RTCError code = rtcGetDeviceError(device);
@@ -728,29 +741,15 @@ int64_t RayScene::num_untraceable_rays() const {
 }
 
 bool RayScene::Intersect(const Ray& ray, SurfaceHit* hit) const {
-  if (!impl_->Traceable(ray)) return false;
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
   RTCRayHit rh;
-  ToEmbree(ray, &rh.ray);
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(impl_->top, &ctx, &rh);
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  if (!impl_->Closest(ray, &rh)) return false;
   impl_->FinishHit(ray, rh, hit);
   return true;
 }
 
 bool RayScene::IntersectIds(const Ray& ray, RayHitIds* ids) const {
-  if (!impl_->Traceable(ray)) return false;
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
   RTCRayHit rh;
-  ToEmbree(ray, &rh.ray);
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(impl_->top, &ctx, &rh);
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  if (!impl_->Closest(ray, &rh)) return false;
   const int group = impl_->group_of_instance[rh.hit.instID[0]];
   const GeomRecord& rec = impl_->groups[group].records[rh.hit.geomID];
   ids->t = rh.ray.tfar;
