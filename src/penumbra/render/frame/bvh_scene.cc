@@ -65,6 +65,15 @@ BvhScene::BvhScene(const SceneDescription& scene, ThreadPool* pool) : scene_(sce
   BuildAll();
 }
 
+int BvhScene::AddRecord(const Record& rec, int k, const Pose& X_IG) {
+  const int record = static_cast<int>(records_.size());
+  records_.push_back(rec);
+  record_group_.push_back(k);
+  X_GI_.push_back(X_IG.inverse());
+  record_first_input_.push_back(static_cast<int32_t>(prims_.size()));
+  return record;
+}
+
 void BvhScene::AddGeom(int gi, const Pose& X_IG, std::vector<PrimBox>* boxes, int record) {
   const Geom& geom = scene_.geoms[gi];
   if (geom.shape == GeomShape::kBox || geom.shape == GeomShape::kMesh ||
@@ -217,11 +226,7 @@ void BvhScene::BuildGroup(int k, std::vector<int32_t>* prim_index) {
       rec.mujoco_id = geom.id;
       rec.body = geom.body;
       rec.semantic_class = geom.semantic_class;
-      const int record = static_cast<int>(records_.size());
-      records_.push_back(rec);
-      record_group_.push_back(k);
-      X_GI_.push_back(X_IG.inverse());
-      record_first_input_.push_back(static_cast<int32_t>(prims_.size()));
+      const int record = AddRecord(rec, k, X_IG);
       record_of_geom_[gi] = record;
       AddGeom(gi, X_IG, &boxes, record);
     }
@@ -269,11 +274,7 @@ void BvhScene::AddTendons(int k, std::vector<PrimBox>* boxes) {
       Record rec;
       rec.geom = -1;
       rec.material = tendon.material;
-      const int record = static_cast<int>(records_.size());
-      records_.push_back(rec);
-      record_group_.push_back(k);
-      X_GI_.push_back(X_IG.inverse());
-      record_first_input_.push_back(static_cast<int32_t>(prims_.size()));
+      const int record = AddRecord(rec, k, X_IG);
       const double size[3] = {tendon.width_m, 0.5 * length, 0};
       AddAnalytic(capsule ? AnalyticKind::kCapsule : AnalyticKind::kSphere, size, X_IG,
                   "a segment of tendon '" + tendon.name + "'", boxes, record);

@@ -102,6 +102,9 @@ class BvhScene {
   // appends group k's records, primitives, BLAS nodes and Blas (prim_index: BuildBvh's order of
   // every primitive so far; the group's primitives are then in its leaves' order)
   void BuildGroup(int k, std::vector<int32_t>* prim_index);
+  // appends record `rec` of group k posed at X_IG (its primitives start at the next one);
+  // returns its index
+  int AddRecord(const Record& rec, int k, const Pose& X_IG);
   void AddGeom(int gi, const Pose& X_IG, std::vector<PrimBox>* boxes, int record);
   void AddAnalytic(AnalyticKind kind, const double size[3], const Pose& X_IG,
                    const std::string& what, std::vector<PrimBox>* boxes, int record);
