@@ -85,6 +85,15 @@ struct HostShadowPush {
 
 namespace {
 
+// fn(u, v) for every pixel of a W x H frame, its rows in parallel over `pool` (may be null), as
+// the kernels' one thread a pixel
+template <typename Fn>
+void ForEachPixel(ThreadPool* pool, int W, int H, const Fn& fn) {
+  ParallelForOrSerial(pool, H, [&](int64_t v) {
+    for (int u = 0; u < W; ++u) fn(u, static_cast<int>(v));
+  });
+}
+
 // the shared visibility of frame f by shadow tiles, as the kernels' blocks
 // (VisibilityRaysWarpKernel, VisibilityTileKernel) do it in shared memory: per tile, its
 // surfaces and every light's verdicts as bit rows copied for the penumbra rays
@@ -177,12 +186,10 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
   std::vector<SurfaceTerms> surfaces(stored_surface ? n : 0);
   if (out->depth_m.width != W || out->depth_m.height != H || out->depth_m.channels != 1)
     out->depth_m = ImageF(W, H, 1);
-  ParallelForOrSerial(pool, H, [&](int64_t v) {
-    for (int u = 0; u < W; ++u) {
-      const int64_t i = v * W + u;
-      geometry[i] = PrimaryGeometry(geo_view, u, static_cast<int>(v), &out->depth_m.data[i],
-                                    nullptr, stored_surface ? &surfaces[i] : nullptr);
-    }
+  ForEachPixel(pool, W, H, [&](int u, int v) {
+    const int64_t i = int64_t{v} * W + u;
+    geometry[i] = PrimaryGeometry(geo_view, u, v, &out->depth_m.data[i], nullptr,
+                                  stored_surface ? &surfaces[i] : nullptr);
   });
   // the mirror layer's rays, traced from the primary geometry (on the GPU their geometry
   // makes the round trip to the host with the primary geometry's)
@@ -198,9 +205,7 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
     mirror_view.geometry = geometry.data();
     mirror_view.mirror_geometry = mirror_geometry.data();
     mirror_view.mirror_hits = mirror_hits.data();
-    ParallelForOrSerial(pool, H, [&](int64_t v) {
-      for (int u = 0; u < W; ++u) TraceMirrorRay(mirror_view, u, static_cast<int>(v));
-    });
+    ForEachPixel(pool, W, H, [&](int u, int v) { TraceMirrorRay(mirror_view, u, v); });
     data.MirrorSkyTerms(mirror_geometry.data(), n, mirror_sky.data(), pool);
   }
   std::vector<Float3> sky(n);
@@ -221,9 +226,7 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
       const StreakProjection p = SplatProjection(f, f.splat.streaks.streaks[k]);
       for (int v = p.v0; v <= p.v1 && !p.empty(); ++v) SplatStreakRow(f, k, p, v);
     }
-    ParallelForOrSerial(pool, H, [&](int64_t v) {
-      for (int u = 0; u < W; ++u) ShadeSplatPixel(f, u, static_cast<int>(v));
-    });
+    ForEachPixel(pool, W, H, [&](int u, int v) { ShadeSplatPixel(f, u, v); });
   }
   // the media volumes the frame builds itself, as the device's kernels (before the shading)
   MediaVolumeArrays media_volumes;
@@ -303,28 +306,18 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
   if (tiled_visibility) {
     TiledSharedVisibility(f, pool, radiance.data());
   } else {
-    ParallelForOrSerial(pool, H, [&](int64_t v) {
-      for (int u = 0; u < W; ++u) SharedVisibilityRays(f, u, static_cast<int>(v));
-    });
-    ParallelForOrSerial(pool, H, [&](int64_t v) {
-      for (int u = 0; u < W; ++u) SharedVisibilityFraction(f, u, static_cast<int>(v));
-    });
-    ParallelForOrSerial(pool, H, [&](int64_t v) {
-      for (int u = 0; u < W; ++u) {
-        Float3& L = radiance[v * W + u];
-        L = SharedVisibilityResolve(f, u, static_cast<int>(v), L);
-      }
+    ForEachPixel(pool, W, H, [&](int u, int v) { SharedVisibilityRays(f, u, v); });
+    ForEachPixel(pool, W, H, [&](int u, int v) { SharedVisibilityFraction(f, u, v); });
+    ForEachPixel(pool, W, H, [&](int u, int v) {
+      Float3& L = radiance[int64_t{v} * W + u];
+      L = SharedVisibilityResolve(f, u, v, L);
     });
   }
   if (f.any_mirror != 0) {
-    ParallelForOrSerial(pool, H, [&](int64_t v) {
-      for (int u = 0; u < W; ++u) ShadeMirrorHit(f, u, static_cast<int>(v));
-    });
-    ParallelForOrSerial(pool, H, [&](int64_t v) {
-      for (int u = 0; u < W; ++u) {
-        Float3& L = radiance[v * W + u];
-        L = ApplyMirrorLayer(f, u, static_cast<int>(v), L);
-      }
+    ForEachPixel(pool, W, H, [&](int u, int v) { ShadeMirrorHit(f, u, v); });
+    ForEachPixel(pool, W, H, [&](int u, int v) {
+      Float3& L = radiance[int64_t{v} * W + u];
+      L = ApplyMirrorLayer(f, u, v, L);
     });
   }
   // the media (and the streaks seen through them) over the final radiance, per 2x2 quad, as
