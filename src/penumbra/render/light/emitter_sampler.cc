@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numbers>
 #include <string>
 
@@ -25,24 +26,20 @@ double BuildCdf(const std::vector<double>& w, std::vector<double>* cdf) {
   return total;
 }
 
-EmitterShape ShapeOf(GeomShape s) {
-  switch (s) {
-    case GeomShape::kSphere:
-      return EmitterShape::kSphere;
-    case GeomShape::kPlane:
-      return EmitterShape::kPlane;
-    case GeomShape::kBox:
-      return EmitterShape::kBox;
-    case GeomShape::kCylinder:
-      return EmitterShape::kCylinder;
-    case GeomShape::kCapsule:
-      return EmitterShape::kCapsule;
-    case GeomShape::kMesh:
-      return EmitterShape::kMesh;
-    default:
-      return EmitterShape::kOther;
-  }
-}
+// the emitter shape of each GeomShape, in GeomShape's order (kOther: not sampled)
+constexpr EmitterShape kEmitterShapeOf[] = {
+    EmitterShape::kPlane,     // kPlane
+    EmitterShape::kSphere,    // kSphere
+    EmitterShape::kCapsule,   // kCapsule
+    EmitterShape::kOther,     // kEllipsoid
+    EmitterShape::kCylinder,  // kCylinder
+    EmitterShape::kBox,       // kBox
+    EmitterShape::kMesh,      // kMesh
+    EmitterShape::kOther,     // kHeightField
+};
+static_assert(std::size(kEmitterShapeOf) == static_cast<size_t>(GeomShape::kHeightField) + 1);
+
+EmitterShape ShapeOf(GeomShape s) { return kEmitterShapeOf[static_cast<int>(s)]; }
 
 // the rotation (row-major) and translation of a pose, as the shared functions take them.
 void PoseArrays(const Pose& X, double R[9], double t[3]) {
@@ -53,18 +50,8 @@ void PoseArrays(const Pose& X, double R[9], double t[3]) {
 }
 
 bool IsSampledShape(const Geom& g) {
-  switch (g.shape) {
-    case GeomShape::kSphere:
-    case GeomShape::kBox:
-    case GeomShape::kMesh:
-    case GeomShape::kCylinder:
-    case GeomShape::kCapsule:
-      return true;
-    case GeomShape::kPlane:
-      return g.size.x() > 0 && g.size.y() > 0;  // finite planes only
-    default:
-      return false;
-  }
+  if (g.shape == GeomShape::kPlane) return g.size.x() > 0 && g.size.y() > 0;  // finite planes only
+  return ShapeOf(g.shape) != EmitterShape::kOther;
 }
 
 }  // namespace
