@@ -66,6 +66,19 @@ T Trilinear(const T* a, const int r[3], const Eigen::Vector3f& f) {
   return MediaTrilinear(a, r, f.x(), f.y(), f.z());
 }
 
+// light j's value at p_W of the [light][cell] array `a` over light volume `v` (trilinear between
+// the cell centres) in *out; false outside the volume.
+bool LightVolumeLookup(const CellLightsPod& v, const float* a, int j, const Eigen::Vector3f& p_W,
+                       float* out) {
+  using Map3 = Eigen::Map<const Eigen::Vector3f>;
+  const Map3 lo(v.lo), hi(v.hi), cells_per_m(v.cells_per_m);
+  if (!(p_W.array() >= lo.array()).all() || !(p_W.array() <= hi.array()).all()) return false;
+  const Eigen::Vector3f f = (p_W - lo).cwiseProduct(cells_per_m) - Eigen::Vector3f::Constant(0.5f);
+  const size_t cells = static_cast<size_t>(v.r[0]) * v.r[1] * v.r[2];
+  *out = Trilinear(a + j * cells, v.r, f);
+  return true;
+}
+
 // e^x per channel; one exponential when the channels are equal (grey media).
 Eigen::Vector3f Exp(const Eigen::Vector3f& x) {
   if (x.x() == x.y() && x.y() == x.z()) return Eigen::Vector3f::Constant(std::exp(x.x()));
@@ -289,29 +302,20 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
     if ((size.array() > 0).all()) {
       vol_.active = true;
       vol_.with_visibility = !media.analytic().empty();
-      vol_.lo = lo;
-      vol_.hi = hi;
       const float cell = std::cbrt(size.prod() / kLightVolumeCells);
       for (int k = 0; k < 3; ++k) {
-        vol_.r[k] = std::clamp(static_cast<int>(std::ceil(size[k] / cell)), 1, 128);
-        vol_.cells_per_m[k] = vol_.r[k] / size[k];
+        cl_pod_.lo[k] = lo[k];
+        cl_pod_.hi[k] = hi[k];
+        cl_pod_.r[k] = std::clamp(static_cast<int>(std::ceil(size[k] / cell)), 1, 128);
+        cl_pod_.cells_per_m[k] = cl_pod_.r[k] / size[k];
+        vol_.lo4[k] = cl_pod_.lo[k];
+        vol_.hi4[k] = cl_pod_.hi[k];
+        vol_.cpm4[k] = cl_pod_.cells_per_m[k];
+        vol_.rmax4[k] = static_cast<float>(cl_pod_.r[k] - 1);
+        vol_.imax4[k] = static_cast<float>(std::max(cl_pod_.r[k] - 2, 0));
       }
-      for (int k = 0; k < 3; ++k) {
-        vol_.lo4[k] = vol_.lo[k];
-        vol_.hi4[k] = vol_.hi[k];
-        vol_.cpm4[k] = vol_.cells_per_m[k];
-        vol_.rmax4[k] = static_cast<float>(vol_.r[k] - 1);
-        vol_.imax4[k] = static_cast<float>(std::max(vol_.r[k] - 2, 0));
-      }
-      const int cells = vol_.r[0] * vol_.r[1] * vol_.r[2];
-      vol_.stride = (nl + 3) / 4 * 4;
-      for (int k = 0; k < 3; ++k) {
-        cl_pod_.lo[k] = vol_.lo[k];
-        cl_pod_.hi[k] = vol_.hi[k];
-        cl_pod_.cells_per_m[k] = vol_.cells_per_m[k];
-        cl_pod_.r[k] = vol_.r[k];
-      }
-      cl_pod_.stride = vol_.stride;
+      const int cells = cl_pod_.r[0] * cl_pod_.r[1] * cl_pod_.r[2];
+      cl_pod_.stride = (nl + 3) / 4 * 4;
       if (device_volumes) {
         device_build_.light_volume = 1;
         device_build_.with_visibility = vol_.with_visibility ? 1 : 0;
@@ -356,12 +360,12 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
           });
         }
         // the same values with the lights of a cell adjacent (LightTransmittances).
-        vol_.trans_cl.assign(static_cast<size_t>(cells) * vol_.stride, 0.0f);
+        vol_.trans_cl.assign(static_cast<size_t>(cells) * cl_pod_.stride, 0.0f);
         if (vol_.with_visibility)
-          vol_.vis_cl.assign(static_cast<size_t>(cells) * vol_.stride, 0.0f);
+          vol_.vis_cl.assign(static_cast<size_t>(cells) * cl_pod_.stride, 0.0f);
         for (int l = 0; l < nl; ++l) {
           for (int c = 0; c < cells; ++c) {
-            const size_t at = static_cast<size_t>(c) * vol_.stride + l;
+            const size_t at = static_cast<size_t>(c) * cl_pod_.stride + l;
             vol_.trans_cl[at] = vol_.trans[static_cast<size_t>(l) * cells + c];
             if (vol_.with_visibility)
               vol_.vis_cl[at] = vol_.vis[static_cast<size_t>(l) * cells + c];
@@ -616,13 +620,10 @@ float RealtimeMedia::GridLightT(int g, int j, const Eigen::Vector3f& p_W, const 
 
 float RealtimeMedia::FogVisibility(int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
                                    float dist) const {
-  if (vol_.with_visibility && j < num_lights_ && (p_W.array() >= vol_.lo.array()).all() &&
-      (p_W.array() <= vol_.hi.array()).all()) {
-    const Eigen::Vector3f f =
-        (p_W - vol_.lo).cwiseProduct(vol_.cells_per_m) - Eigen::Vector3f::Constant(0.5f);
-    const size_t cells = static_cast<size_t>(vol_.r[0]) * vol_.r[1] * vol_.r[2];
-    return Trilinear(vol_.vis.data() + j * cells, vol_.r, f);
-  }
+  float V;
+  if (vol_.with_visibility && j < num_lights_ &&
+      LightVolumeLookup(cl_pod_, vol_.vis.data(), j, p_W, &V))
+    return V;
   float T = std::exp(-Mean3(media_->AnalyticOpticalDepth(p_W, wi, 0, dist)));
   for (size_t g = 0; g < grid_light_.size(); ++g)
     T *= GridLightT(static_cast<int>(g), j, p_W, wi, dist);
@@ -671,8 +672,7 @@ bool RealtimeMedia::CellLightsLookupSse(const float* cl, const Eigen::Vector3f& 
   }
   // the eight corners (+1 along x, y, z for bits 0, 1, 2 of the corner index) and their
   // trilinear weights, summed in corner order; lights adjacent per cell.
-  // cl_pod_: vol_'s layout
-  const size_t S = static_cast<size_t>(vol_.stride);
+  const size_t S = static_cast<size_t>(cl_pod_.stride);
   const CellCorners k = CellLightsCorners(cl_pod_, cl, base, step);
   const size_t ox = k.ox, oy = k.oy, oz = k.oz;
   float wc[8];
@@ -695,13 +695,10 @@ bool RealtimeMedia::CellLightsLookupSse(const float* cl, const Eigen::Vector3f& 
 
 Eigen::Vector3f RealtimeMedia::LightTransmittance(int j, const Eigen::Vector3f& p_W,
                                                   const Eigen::Vector3f& wi, float dist) const {
-  if (vol_.active && j < num_lights_ && (p_W.array() >= vol_.lo.array()).all() &&
-      (p_W.array() <= vol_.hi.array()).all()) {
-    const Eigen::Vector3f f =
-        (p_W - vol_.lo).cwiseProduct(vol_.cells_per_m) - Eigen::Vector3f::Constant(0.5f);
-    const size_t cells = static_cast<size_t>(vol_.r[0]) * vol_.r[1] * vol_.r[2];
-    return Eigen::Vector3f::Constant(Trilinear(vol_.trans.data() + j * cells, vol_.r, f));
-  }
+  float T_volume;
+  if (vol_.active && j < num_lights_ &&
+      LightVolumeLookup(cl_pod_, vol_.trans.data(), j, p_W, &T_volume))
+    return Eigen::Vector3f::Constant(T_volume);
   Eigen::Vector3f T = media_->analytic().empty()
                           ? Eigen::Vector3f::Ones()
                           : Exp(-media_->AnalyticOpticalDepth(p_W, wi, 0, dist));

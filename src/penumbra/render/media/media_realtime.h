@@ -238,11 +238,9 @@ class RealtimeMedia {
   struct LightVolume {
     bool active = false;
     bool with_visibility = false;  // vis is filled (homogeneous media present)
-    Eigen::Vector3f lo{0, 0, 0}, hi{0, 0, 0}, cells_per_m{1, 1, 1};
-    int r[3] = {1, 1, 1};
+    // its box, cells and lights per cell (num lights rounded up to 4): RealtimeMedia::cl_pod_
     std::vector<float> trans;     // [light][cell] Th Tgrid (channel mean)
     std::vector<float> vis;       // [light][cell] V Th Tgrid
-    int stride = 0;               // lights per cell in trans_cl (num lights rounded up to 4)
     std::vector<float> trans_cl;  // [cell][light] copy of trans (LightTransmittances)
     std::vector<float> vis_cl;    // [cell][light] copy of vis (BuildFogFroxels)
     // lo, hi, cells_per_m, r - 1 and max(r - 2, 0) per axis, 4th lane 0 (CellLightsLookup).
@@ -302,7 +300,7 @@ class RealtimeMedia {
   // pixel rays; in pods_), and whether every homogeneous medium's sigma_t is grey.
   float h_cam_oz_ = 0;
   std::vector<MediumPod> pods_;
-  CellLightsPod cl_pod_;
+  CellLightsPod cl_pod_;  // the world light volume's layout (vol_'s box, cells, stride)
   bool grey_t_ = false;
   int num_lights_ = 0;  // lights with volumes
   std::vector<GridLight> grid_light_;
