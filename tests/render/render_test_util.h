@@ -82,6 +82,33 @@ inline WorldSnapshot IdentitySnapshot(const SceneDescription& s) {
   return snap;
 }
 
+/// a scene of every shape kind, static and moving, for comparing two ray tracers: a floor
+/// plane at z = -1, a static box, sphere and cylinder in front of +x, and a body "mover" (its
+/// index in *mover) with a tilted capsule, a cylinder, an ellipsoid and a box.
+inline SceneDescription EveryShapeScene(int* mover) {
+  SceneDescription scene = EmptyScene();
+  AddGeom(&scene, GeomShape::kPlane, {0, 0, 1}, Translation(0, 0, -1));
+  AddGeom(&scene, GeomShape::kBox, {0.3, 0.4, 0.5}, Translation(4, 0.8, 0.2));
+  AddGeom(&scene, GeomShape::kSphere, {0.35, 0, 0}, Translation(3, -0.7, 0.1));
+  AddGeom(&scene, GeomShape::kCylinder, {0.2, 0.6, 0}, Translation(5, -1.5, 0.1));
+  const int body = AddBody(&scene, "mover");
+  Pose X_BG = Translation(0, 0.3, 0);
+  X_BG.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  AddGeom(&scene, GeomShape::kCapsule, {0.15, 0.3, 0}, X_BG, body);
+  AddGeom(&scene, GeomShape::kCylinder, {0.2, 0.25, 0}, Translation(0, -0.4, 0.2), body);
+  AddGeom(&scene, GeomShape::kEllipsoid, {0.2, 0.3, 0.15}, Translation(0, 0.1, -0.45), body);
+  AddGeom(&scene, GeomShape::kBox, {0.1, 0.1, 0.1}, Translation(0.1, -0.1, 0.5), body);
+  *mover = body;
+  return scene;
+}
+
+/// EveryShapeScene's mover at (2.5, 0.1, -0.1), turned by yaw_rad about world z.
+inline void PoseEveryShapeMover(WorldSnapshot* snapshot, int mover, double yaw_rad) {
+  snapshot->X_WB[mover] = Translation(2.5, 0.1, -0.1);
+  snapshot->X_WB[mover].linear() =
+      Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
 /// optical frame at `p` looking along world +x (image x = world -y, image y = world -z).
 inline Pose CameraLookingAlongX(const Eigen::Vector3d& p = Eigen::Vector3d::Zero()) {
   Pose X = Pose::Identity();

@@ -80,25 +80,13 @@ int ExpectSameNames(const RayScene& embree, const cuda::BvhScene& bvh,
 }
 
 TEST(EmbreeTracer, NamesEveryShapeStaticAndMovingAsTheBvh) {
-  SceneDescription scene = testing::EmptyScene();
-  AddGeom(&scene, GeomShape::kPlane, {0, 0, 1}, Translation(0, 0, -1));
-  AddGeom(&scene, GeomShape::kBox, {0.3, 0.4, 0.5}, Translation(4, 0.8, 0.2));
-  AddGeom(&scene, GeomShape::kSphere, {0.35, 0, 0}, Translation(3, -0.7, 0.1));
-  AddGeom(&scene, GeomShape::kCylinder, {0.2, 0.6, 0}, Translation(5, -1.5, 0.1));
-  const int body = testing::AddBody(&scene, "mover");
-  Pose X_BG = Translation(0, 0.3, 0);
-  X_BG.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  AddGeom(&scene, GeomShape::kCapsule, {0.15, 0.3, 0}, X_BG, body);
-  AddGeom(&scene, GeomShape::kCylinder, {0.2, 0.25, 0}, Translation(0, -0.4, 0.2), body);
-  AddGeom(&scene, GeomShape::kEllipsoid, {0.2, 0.3, 0.15}, Translation(0, 0.1, -0.45), body);
-  AddGeom(&scene, GeomShape::kBox, {0.1, 0.1, 0.1}, Translation(0.1, -0.1, 0.5), body);
+  int body = 0;
+  const SceneDescription scene = testing::EveryShapeScene(&body);
   WorldSnapshot snapshot = testing::IdentitySnapshot(scene);
   RayScene embree(scene);
   cuda::BvhScene bvh(scene);
   for (double yaw : {0.4, -1.1}) {
-    snapshot.X_WB[body] = Translation(2.5, 0.1, -0.1);
-    snapshot.X_WB[body].linear() =
-        Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    testing::PoseEveryShapeMover(&snapshot, body, yaw);
     embree.Update(snapshot);
     bvh.Update(snapshot);
     const std::vector<cuda::TraceRay> rays = Fan({-1, 0, 0.2f}, {1, 0, -0.05f}, 160, 120, 0.8f);
